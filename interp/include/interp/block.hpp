@@ -152,6 +152,10 @@ public:
     virtual double spindle_rpm() = 0;
     // Modal state the front end needs: 1.0 under G21/G71, 25.4 under G20/G70.
     virtual double mm_per_program_unit() = 0;
+    // G91 active (fills #FC13 when a public.dat custom G code replaces a canned cycle).
+    virtual bool incremental_mode() = 0;
+    // G99 (return to the R plane) active rather than G98 (fills #FC12).
+    virtual bool cycle_return_to_r() = 0;
     // A configured or persisted machine setting of the manual's named-parameter table, by its
     // canonical upper-case name with axis suffix ("SAFEHEIGHT", "BKREF_F1.X", "FIXEDCALI_REC").
     // Lengths in mm. std::nullopt when the machine has no such setting configured.
