@@ -1,0 +1,311 @@
+// Per-cycle step generators: one small function per cycle, chosen by a table.
+// Each function follows the numbered "加工过程说明" list of its cycle in the
+// NcStudio manual (S0 §3.6.4); G76/G87/G88, unsupported there, follow the same
+// lists plus the FEATURES.md recommendations (G76-1, G87-1, G88-1).
+
+#include "hole_steps.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+namespace interp::cycles::detail {
+namespace {
+
+constexpr double kSameLevelMm = 1e-9;
+constexpr long kMaxPecks = 100000;
+
+/// Appends moves, dropping the zero-length ones (a hole straight below the tool,
+/// a G99 retract that is already at R), and tracks the tool position.
+class Emitter {
+  public:
+    Emitter(const HoleSpec& hole, Vec3& position, Expansion& out)
+        : hole_(hole), pos_(position), out_(out) {}
+
+    void rapid_to_level(double c_mm) { move_level(c_mm, true); }
+    void feed_to_level(double c_mm) { move_level(c_mm, false); }
+
+    /// Moves in the positioning plane at the current drilling-axis level.
+    void rapid_in_plane(double a_mm, double b_mm) {
+        Vec3 to = pos_;
+        to[hole_.axes.a] = a_mm;
+        to[hole_.axes.b] = b_mm;
+        move(to, true);
+    }
+    void rapid_shift(double sign) {
+        rapid_in_plane(hole_.pos_a_mm + sign * hole_.q_mm * hole_.shift_dir[0],
+                       hole_.pos_b_mm + sign * hole_.q_mm * hole_.shift_dir[1]);
+    }
+    void dwell() {
+        if (hole_.dwell_s > 0.0) out_.steps.emplace_back(Dwell{hole_.dwell_s});
+    }
+    void push(Step step) { out_.steps.push_back(step); }
+    double level() const { return pos_[hole_.axes.c]; }
+
+  private:
+    void move_level(double c_mm, bool rapid) {
+        Vec3 to = pos_;
+        to[hole_.axes.c] = c_mm;
+        move(to, rapid);
+    }
+    void move(const Vec3& to, bool rapid) {
+        bool same = true;
+        for (int i = 0; i < 3; ++i) same = same && std::abs(to[i] - pos_[i]) <= kSameLevelMm;
+        if (same) return;
+        if (rapid)
+            out_.steps.emplace_back(Rapid{to});
+        else
+            out_.steps.emplace_back(Feed{to, hole_.feed_mm_min});
+        pos_ = to;
+    }
+
+    const HoleSpec& hole_;
+    Vec3& pos_;
+    Expansion& out_;
+};
+
+double return_level(const HoleSpec& h) {
+    return h.return_to_r ? h.r_mm : h.initial_mm;
+}
+
+/// Steps 1–2 of every cycle but G87: position in the plane, rapid to R.
+void approach(const HoleSpec& h, Emitter& e) {
+    e.rapid_in_plane(h.pos_a_mm, h.pos_b_mm);
+    e.rapid_to_level(h.r_mm);
+}
+
+long peck_count(const HoleSpec& h) {
+    const double pecks = std::ceil((h.r_mm - h.z_mm) / h.q_mm);
+    if (pecks > kMaxPecks)
+        throw CycleError(fmt::format("G{}: Q{:g} gives more than {} pecks for the depth {:g}",
+                                     g_number(h.code), h.q_mm, kMaxPecks, h.r_mm - h.z_mm));
+    return static_cast<long>(pecks);
+}
+
+// G81: 1) G00 to X Y 2) G00 to R 3) G01 to Z 4) G00 to initial (G98) or R (G99).
+void g81(const HoleSpec& h, const CycleConfig&, const BlockContext&, Emitter& e) {
+    approach(h, e);
+    e.feed_to_level(h.z_mm);
+    e.rapid_to_level(return_level(h));
+}
+
+// G82: as G81 with 4) dwell P before the rapid retract.
+void g82(const HoleSpec& h, const CycleConfig&, const BlockContext&, Emitter& e) {
+    approach(h, e);
+    e.feed_to_level(h.z_mm);
+    e.dwell();
+    e.rapid_to_level(return_level(h));
+}
+
+// G73: 3) feed Q below the depth reached so far 4) rapid up δ 5) repeat to Z
+// 6) rapid to initial/R. No δ retract after the last peck (it is the retract).
+void g73(const HoleSpec& h, const CycleConfig& cfg, const BlockContext&, Emitter& e) {
+    approach(h, e);
+    peck_count(h);
+    double depth = h.r_mm;
+    while (depth > h.z_mm) {
+        depth = std::max(depth - h.q_mm, h.z_mm);
+        e.feed_to_level(depth);
+        if (depth > h.z_mm) e.rapid_to_level(depth + cfg.retract_mm);
+    }
+    e.rapid_to_level(return_level(h));
+}
+
+// G83: 3) feed Q 4) rapid to R 5) rapid down to δ above the previous depth
+// 6) feed Q deeper 7) rapid to R 8) repeat to Z 9) rapid to initial/R.
+void g83(const HoleSpec& h, const CycleConfig& cfg, const BlockContext&, Emitter& e) {
+    approach(h, e);
+    peck_count(h);
+    double depth = h.r_mm;
+    while (depth > h.z_mm) {
+        if (depth < h.r_mm) e.rapid_to_level(std::min(depth + cfg.retract_mm, h.r_mm));
+        depth = std::max(depth - h.q_mm, h.z_mm);
+        e.feed_to_level(depth);
+        if (depth > h.z_mm) e.rapid_to_level(h.r_mm);
+    }
+    e.rapid_to_level(return_level(h));
+}
+
+// G74/G84: 3) G01 to Z 4) dwell P, reverse 5) G01 up to R 6) dwell P, reverse
+// back 7) G00 to the initial level (G98). The tapping speed parameter replaces S
+// for the cut (NcStudio G84 note) and S is restored once back at R.
+void tap(const HoleSpec& h, const CycleConfig& cfg, const BlockContext& ctx, Emitter& e,
+         Spindle required, const char* m_code) {
+    if (ctx.spindle != required)
+        throw CycleError(
+            fmt::format("G{} needs the spindle running {} ({}) before the cycle", g_number(h.code),
+                        required == Spindle::Cw ? "clockwise" : "counter-clockwise", m_code));
+    approach(h, e);
+    if (cfg.tap_spindle_rpm) e.push(SpindleSpeed{*cfg.tap_spindle_rpm});
+    e.feed_to_level(h.z_mm);
+    e.dwell();
+    e.push(SpindleReverse{});
+    e.feed_to_level(h.r_mm);
+    e.dwell();
+    e.push(SpindleReverse{});
+    if (cfg.tap_spindle_rpm) e.push(SpindleSpeed{h.spindle_rpm});
+    e.rapid_to_level(return_level(h));
+}
+void g74(const HoleSpec& h, const CycleConfig& cfg, const BlockContext& ctx, Emitter& e) {
+    tap(h, cfg, ctx, e, Spindle::Ccw, "M04");
+}
+void g84(const HoleSpec& h, const CycleConfig& cfg, const BlockContext& ctx, Emitter& e) {
+    tap(h, cfg, ctx, e, Spindle::Cw, "M03");
+}
+
+// G76: 2) G00 to R without orienting 3) G01 to Z, dwell P, oriented stop
+// 4) shift Q in the OSS direction 5) G00 to initial/R 6) restart the spindle.
+// REC G76-1: shift back before the restart so the next hole starts centred.
+void g76(const HoleSpec& h, const CycleConfig&, const BlockContext&, Emitter& e) {
+    approach(h, e);
+    e.feed_to_level(h.z_mm);
+    e.dwell();
+    e.push(SpindleOrient{});
+    e.rapid_shift(+1.0);
+    e.rapid_to_level(return_level(h));
+    e.rapid_shift(0.0);
+    e.push(SpindleRestart{});
+}
+
+// G85: 3) G01 to Z 4) G01 back to R 5) G00 to initial (G98).
+void g85(const HoleSpec& h, const CycleConfig&, const BlockContext&, Emitter& e) {
+    approach(h, e);
+    e.feed_to_level(h.z_mm);
+    e.feed_to_level(h.r_mm);
+    e.rapid_to_level(return_level(h));
+}
+
+// G86: 3) G01 to Z 4) spindle stop 5) G00 to initial/R 6) spindle restarts.
+void g86(const HoleSpec& h, const CycleConfig&, const BlockContext&, Emitter& e) {
+    approach(h, e);
+    e.feed_to_level(h.z_mm);
+    e.push(SpindleStop{});
+    e.rapid_to_level(return_level(h));
+    e.push(SpindleRestart{});
+}
+
+// G87 back boring, R is the bottom: 1) G00 to X Y 2) oriented stop, shift −Q
+// 3) G00 down to R, shift +Q 4) spindle CW 5) G01 up to Z 6) dwell P, oriented
+// stop, shift −Q 7) G00 up to the initial level 8) shift +Q, restart.
+void g87(const HoleSpec& h, const CycleConfig&, const BlockContext&, Emitter& e) {
+    e.rapid_in_plane(h.pos_a_mm, h.pos_b_mm);
+    e.push(SpindleOrient{});
+    e.rapid_shift(-1.0);
+    e.rapid_to_level(h.r_mm);
+    e.rapid_shift(0.0);
+    e.push(SpindleCw{});
+    e.feed_to_level(h.z_mm);
+    e.dwell();
+    e.push(SpindleOrient{});
+    e.rapid_shift(-1.0);
+    e.rapid_to_level(h.initial_mm);
+    e.rapid_shift(0.0);
+    e.push(SpindleRestart{});
+}
+
+// G88: 3) G01 to Z 4) dwell P, spindle stop 5) G01 to R (feed mode) or the
+// operator jogs out (manual mode) 6) G00 to initial/R 7) spindle CW (restart).
+void g88(const HoleSpec& h, const CycleConfig& cfg, const BlockContext&, Emitter& e) {
+    approach(h, e);
+    e.feed_to_level(h.z_mm);
+    e.dwell();
+    e.push(SpindleStop{});
+    if (cfg.g88_retract == G88Retract::Feed)
+        e.feed_to_level(h.r_mm);
+    else
+        e.push(OperatorRetract{});
+    e.rapid_to_level(return_level(h));
+    e.push(SpindleRestart{});
+}
+
+// G89: 3) G01 to Z 4) dwell P 5) G01 up to R 6) G00 to initial/R.
+void g89(const HoleSpec& h, const CycleConfig&, const BlockContext&, Emitter& e) {
+    approach(h, e);
+    e.feed_to_level(h.z_mm);
+    e.dwell();
+    e.feed_to_level(h.r_mm);
+    e.rapid_to_level(return_level(h));
+}
+
+using CycleFn = void (*)(const HoleSpec&, const CycleConfig&, const BlockContext&, Emitter&);
+struct CycleEntry {
+    CycleCode code;
+    CycleFn fn;
+};
+constexpr CycleEntry kCycles[] = {
+    {CycleCode::G73, g73}, {CycleCode::G74, g74}, {CycleCode::G76, g76}, {CycleCode::G81, g81},
+    {CycleCode::G82, g82}, {CycleCode::G83, g83}, {CycleCode::G84, g84}, {CycleCode::G85, g85},
+    {CycleCode::G86, g86}, {CycleCode::G87, g87}, {CycleCode::G88, g88}, {CycleCode::G89, g89},
+};
+
+void check_levels(const HoleSpec& h) {
+    if (h.code == CycleCode::G87) {
+        if (h.r_mm > h.z_mm)
+            throw CycleError(fmt::format(
+                "G87 back boring: the R plane ({:g}) is the hole bottom and must lie below Z "
+                "({:g})",
+                h.r_mm, h.z_mm));
+    } else if (h.z_mm > h.r_mm) {
+        throw CycleError(fmt::format("G{}: the hole bottom Z ({:g}) lies above the R plane ({:g})",
+                                     g_number(h.code), h.z_mm, h.r_mm));
+    }
+}
+
+}  // namespace
+
+AxisMap axis_map(Plane plane, bool drill_axis_follows_plane) {
+    if (!drill_axis_follows_plane) return {0, 1, 2};
+    switch (plane) {
+        case Plane::XY:
+            return {0, 1, 2};
+        case Plane::ZX:
+            return {2, 0, 1};
+        case Plane::YZ:
+            return {1, 2, 0};
+    }
+    return {0, 1, 2};
+}
+
+std::array<double, 2> oss_shift(const CycleConfig& cfg) {
+    const int d = cfg.oss_direction;
+    if (cfg.oss_table == OssTable::NcStudio) {
+        switch (d) {
+            case 0:
+                return {1, 0};
+            case 1:
+                return {-1, 0};
+            case 2:
+                return {0, 1};
+            case 3:
+                return {0, -1};
+        }
+    } else {
+        switch (d) {
+            case 1:
+                return {1, 0};
+            case 0:
+            case 2:
+                return {-1, 0};
+            case 3:
+                return {0, 1};
+            case 4:
+                return {0, -1};
+        }
+    }
+    throw CycleError(
+        fmt::format("oriented spindle stop direction #FIXEDCYCLE_OSS={} is not in the table", d));
+}
+
+void append_hole(const HoleSpec& hole, const BlockContext& ctx, const CycleConfig& cfg,
+                 Vec3& position, Expansion& out) {
+    check_levels(hole);
+    for (const auto& entry : kCycles) {
+        if (entry.code != hole.code) continue;
+        Emitter emitter(hole, position, out);
+        entry.fn(hole, cfg, ctx, emitter);
+        return;
+    }
+    throw CycleError(fmt::format("G{}: no step generator", g_number(hole.code)));
+}
+
+}  // namespace interp::cycles::detail
