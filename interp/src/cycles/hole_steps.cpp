@@ -106,7 +106,8 @@ void g73(const HoleSpec& h, const CycleConfig& cfg, const BlockContext&, Emitter
     while (depth > h.z_mm) {
         depth = std::max(depth - h.q_mm, h.z_mm);
         e.feed_to_level(depth);
-        if (depth > h.z_mm) e.rapid_to_level(depth + cfg.retract_mm);
+        // A δ larger than the depth cut so far would lift above R: stop at R.
+        if (depth > h.z_mm) e.rapid_to_level(std::min(depth + cfg.retract_mm, h.r_mm));
     }
     e.rapid_to_level(return_level(h));
 }
