@@ -1,0 +1,98 @@
+#pragma once
+// The back end: executes evaluated blocks (block.hpp) against the modal state, the coordinate
+// transforms and the persistent settings, and emits canonical commands (canon.hpp). It also
+// answers the front end's machine queries from its own model (standalone / check mode).
+//
+// A block is executed on a copy of the state; only when every step succeeded is the copy
+// committed and the block's canonical commands passed to the sink. So a rejected block changes
+// nothing and emits nothing (STYLE: parse, validate, then commit).
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "interp/block.hpp"
+#include "interp/canon.hpp"
+#include "interp/modal.hpp"
+#include "interp/persist.hpp"
+#include "interp/transform.hpp"
+
+namespace interp {
+
+// Dialect switches of the back end (FEATURES `cfg:` names in comments).
+struct BackendConfig {
+    bool v54_compat = false;          // cfg:ncstudio_v54_compat
+    bool ijk_incremental = true;      // cfg:ncstudio_ijk_incremental
+    bool g00_z_split = true;          // cfg:ncstudio_g00_z_split
+    double arc_tolerance_mm = 0.01;   // cfg:arc_tolerance
+    bool optional_stop = false;       // the operator's M01 switch
+    bool t_changes_tool = true;       // cfg:t_changes_tool (NcStudio 6th: T changes the tool)
+    bool end_stops_spindle = true;    // AUTOSTOPSPINDLE: M02/M30 stop spindle and coolant
+    double max_rapid_mm_s = 0;        // clamp for F in G00 blocks; 0 = no clamp
+    AxisVec reference_mm{};           // G28 reference point, machine coordinates
+    AxisVec home_position_mm{};       // M902: machine origin position parameter per axis
+    std::uint64_t input_bits = 0;     // standalone model of the input ports
+    // Machine settings readable as named parameters (SAFEHEIGHT, MOBICALI_THICKNESS, …), mm.
+    std::map<std::string, double, std::less<>> machine_settings;
+};
+
+// Everything the executor keeps between blocks apart from settings and transforms.
+struct ExecState {
+    MotionModal motion;
+    UnitsModal units;
+    FeedModal feed;
+    SpindleModal spindle;
+    CoolantModal coolant;
+    ToolModal tool;
+    CoordModal coord;
+    Position pos;
+    IoState io;
+    bool started = false;  // the initial offsets have been announced
+};
+
+class Executor final : public BlockExecutor, public MachineQuery {
+public:
+    Executor(CanonSink& sink, BackendConfig cfg, Settings settings = {});
+
+    void execute(const Block& block) override;
+    void end_of_input(const SourceLoc& loc) override;
+
+    // MachineQuery, answered from the executor's own model.
+    double machine_pos_mm(Axis axis) override;
+    double work_pos_mm(Axis axis) override;
+    std::uint64_t input_bits() override { return cfg_.input_bits; }
+    std::uint64_t output_bits() override { return state_.io.outputs; }
+    double spindle_rpm() override;
+    double mm_per_program_unit() override { return state_.units.mm_per_unit; }
+    bool incremental_mode() override { return state_.motion.incremental; }
+    // G98/G99 belong to the canned cycles, which this executor does not run yet (they are an
+    // error here), so the return mode is always the G98 default.
+    bool cycle_return_to_r() override { return false; }
+    std::optional<double> setting(std::string_view name) override;
+
+    // Called after every committed block that changed a persistent setting (for saving).
+    void on_settings_changed(std::function<void(const Settings&)> fn) {
+        settings_listener_ = std::move(fn);
+    }
+    // A persistent named parameter written by the program (front end).
+    void set_persistent_param(std::string_view name, double value);
+
+    const Settings& settings() const { return settings_; }
+    const ExecState& state() const { return state_; }
+    const ProgramTransform& transform() const { return xf_; }
+    const BackendConfig& config() const { return cfg_; }
+
+private:
+    void commit(ExecState&& st, std::optional<ProgramTransform>&& xf,
+                std::optional<Settings>&& settings, std::vector<Canon>& out);
+
+    CanonSink& sink_;
+    BackendConfig cfg_;
+    Settings settings_;
+    ExecState state_;
+    ProgramTransform xf_;
+    std::vector<Canon> out_;  // the current block's commands, reused to avoid allocation
+    std::function<void(const Settings&)> settings_listener_;
+};
+
+}  // namespace interp

@@ -1,0 +1,40 @@
+#pragma once
+// Tool table: per tool an offset vector (NcStudio G923 writes X Y Z; LinuxCNC's Z is the
+// length) and a diameter. Lengths in mm.
+#include <array>
+#include <map>
+#include <string>
+
+namespace interp {
+
+struct ToolEntry {
+    std::array<double, 3> offset_mm{};  // X Y Z; Z is the tool length
+    double diameter_mm = 0;
+    int pocket = 0;
+    std::string comment;
+    bool operator==(const ToolEntry&) const = default;
+};
+
+class ToolTable {
+public:
+    // nullptr when the tool is not in the table.
+    const ToolEntry* find(int tool) const {
+        auto it = tools_.find(tool);
+        return it == tools_.end() ? nullptr : &it->second;
+    }
+    // Creates the entry when missing.
+    ToolEntry& at(int tool) { return tools_[tool]; }
+    const std::map<int, ToolEntry>& entries() const { return tools_; }
+    bool operator==(const ToolTable&) const = default;
+
+private:
+    std::map<int, ToolEntry> tools_;
+};
+
+// Reads a LinuxCNC tool table ("T1 P1 D6.0 Z12.5 ;comment", D = diameter, values in machine
+// units = mm). Throws interp::Error "file:line:col: cause" on the first bad line.
+ToolTable load_linuxcnc_tool_table(const std::string& path);
+// The same from text already in memory; `name` is used in error messages.
+ToolTable parse_linuxcnc_tool_table(const std::string& text, const std::string& name);
+
+}  // namespace interp

@@ -1,0 +1,197 @@
+// Persistent settings file: parse, format, atomic save (see persist.hpp for the format).
+#include "interp/persist.hpp"
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <charconv>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include "interp/block.hpp"
+
+namespace interp {
+
+namespace {
+
+struct Token {
+    std::string text;
+    int col;
+};
+
+std::vector<Token> split(const std::string& line) {
+    std::vector<Token> out;
+    std::size_t i = 0;
+    while (i < line.size()) {
+        if (std::isspace(static_cast<unsigned char>(line[i]))) {
+            ++i;
+            continue;
+        }
+        std::size_t j = i;
+        while (j < line.size() && !std::isspace(static_cast<unsigned char>(line[j]))) ++j;
+        out.push_back({line.substr(i, j - i), static_cast<int>(i) + 1});
+        i = j;
+    }
+    return out;
+}
+
+class LineParser {
+public:
+    LineParser(std::string_view name, int line, std::vector<Token> toks)
+        : name_(name), line_(line), toks_(std::move(toks)) {}
+
+    [[noreturn]] void fail(int col, const std::string& why) const {
+        throw Error(SourceLoc{name_, line_, col}, why);
+    }
+    void expect_count(std::size_t n) const {
+        if (toks_.size() != n)
+            fail(toks_.front().col, fmt::format("settings: '{}' needs {} values, found {}",
+                                                toks_.front().text, n - 1, toks_.size() - 1));
+    }
+    double num(std::size_t i) const {
+        const std::string& t = toks_[i].text;
+        double v = 0;
+        auto [p, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+        if (ec != std::errc() || p != t.data() + t.size())
+            fail(toks_[i].col, fmt::format("settings: '{}' is not a number", t));
+        return v;
+    }
+    int integer(std::size_t i, int lo, int hi) const {
+        double v = num(i);
+        if (v != static_cast<int>(v) || v < lo || v > hi)
+            fail(toks_[i].col, fmt::format("settings: '{}' must be an integer in {}..{}",
+                                           toks_[i].text, lo, hi));
+        return static_cast<int>(v);
+    }
+    AxisVec axes(std::size_t first) const {
+        AxisVec v{};
+        for (int a = 0; a < kMachineAxes; ++a) v[a] = num(first + a);
+        return v;
+    }
+    const std::vector<Token>& toks() const { return toks_; }
+
+private:
+    std::string_view name_;
+    int line_;
+    std::vector<Token> toks_;
+};
+
+void parse_entry(const LineParser& p, Settings& s) {
+    const std::string& key = p.toks().front().text;
+    if (key == "wcs") {
+        p.expect_count(2 + kMachineAxes);
+        s.offsets.wcs[p.integer(1, 1, kWorkSystems) - 1] = p.axes(2);
+    } else if (key == "common") {
+        p.expect_count(1 + kMachineAxes);
+        s.offsets.common = p.axes(1);
+    } else if (key == "g92") {
+        p.expect_count(1 + kMachineAxes);
+        s.offsets.g92 = p.axes(1);
+    } else if (key == "tool") {
+        p.expect_count(6);
+        ToolEntry& e = s.tools.at(p.integer(1, 0, 1000000));
+        e.offset_mm = {p.num(2), p.num(3), p.num(4)};
+        e.diameter_mm = p.num(5);
+        if (e.diameter_mm < 0) p.fail(p.toks()[5].col, "settings: negative tool diameter");
+    } else if (key == "param") {
+        p.expect_count(3);
+        s.params[p.toks()[1].text] = p.num(2);
+    } else {
+        p.fail(p.toks().front().col, fmt::format("settings: unknown entry '{}'", key));
+    }
+}
+
+std::string axes_line(const AxisVec& v) {
+    std::string s;
+    for (double d : v) s += fmt::format(" {}", d);  // shortest round-trip form
+    return s;
+}
+
+[[noreturn]] void sys_fail(const std::string& what, const std::string& path) {
+    throw std::runtime_error(fmt::format("{}: {}: {}", path, what, std::strerror(errno)));
+}
+
+}  // namespace
+
+Settings parse_settings(const std::string& text, const std::string& name) {
+    Settings s;
+    std::istringstream in(text);
+    std::string line;
+    int line_no = 0;
+    while (std::getline(in, line)) {
+        ++line_no;
+        if (auto hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+        auto toks = split(line);
+        if (toks.empty()) continue;
+        parse_entry(LineParser(name, line_no, std::move(toks)), s);
+    }
+    return s;
+}
+
+Settings load_settings(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) {
+        if (!std::filesystem::exists(path)) return Settings{};
+        throw Error(SourceLoc{path, 0, 0}, "settings: cannot read file");
+    }
+    std::ostringstream ss;
+    ss << f.rdbuf();
+    return parse_settings(ss.str(), path);
+}
+
+std::string format_settings(const Settings& s) {
+    std::string out = "# cnc interpreter persistent settings (mm)\n";
+    for (int i = 0; i < kWorkSystems; ++i)
+        out += fmt::format("wcs {}{}\n", i + 1, axes_line(s.offsets.wcs[i]));
+    out += "common" + axes_line(s.offsets.common) + "\n";
+    out += "g92" + axes_line(s.offsets.g92) + "\n";
+    for (const auto& [n, e] : s.tools.entries())
+        out += fmt::format("tool {} {} {} {} {}\n", n, e.offset_mm[0], e.offset_mm[1],
+                           e.offset_mm[2], e.diameter_mm);
+    for (const auto& [k, v] : s.params) out += fmt::format("param {} {}\n", k, v);
+    return out;
+}
+
+void save_settings_atomic(const std::string& path, const Settings& s) {
+    const std::string text = format_settings(s);
+    const std::string tmp = path + ".tmp";
+    int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) sys_fail("cannot create temporary settings file", tmp);
+    std::size_t done = 0;
+    while (done < text.size()) {
+        ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            ::close(fd);
+            ::unlink(tmp.c_str());
+            sys_fail("cannot write settings", tmp);
+        }
+        done += static_cast<std::size_t>(n);
+    }
+    if (::fsync(fd) != 0) {
+        ::close(fd);
+        ::unlink(tmp.c_str());
+        sys_fail("cannot fsync settings", tmp);
+    }
+    ::close(fd);
+    if (::rename(tmp.c_str(), path.c_str()) != 0) {
+        ::unlink(tmp.c_str());
+        sys_fail("cannot replace settings file", path);
+    }
+    // The rename itself must reach the disk, or a crash could bring back the old name.
+    std::string dir = std::filesystem::path(path).parent_path().string();
+    if (dir.empty()) dir = ".";
+    int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (dfd >= 0) {
+        ::fsync(dfd);
+        ::close(dfd);
+    }
+}
+
+}  // namespace interp

@@ -1,0 +1,600 @@
+// Back-end unit tests with hand-built blocks. Every expected number below was worked out by hand
+// from the manual's rule named in the test (FEATURES ids in the names).
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "block_builder.hpp"
+#include "interp/executor.hpp"
+
+namespace interp {
+namespace {
+
+using test::blk;
+
+struct Recorder : CanonSink {
+    std::vector<Canon> all;
+    void emit(const Canon& c) override { all.push_back(c); }
+};
+
+class ExecTest : public ::testing::Test {
+protected:
+    void make(BackendConfig cfg = {}, Settings s = {}) {
+        rec = Recorder{};
+        exec = std::make_unique<Executor>(rec, cfg, s);
+    }
+    void SetUp() override { make(); }
+
+    // Executes the lines and returns the text of the commands they produced, without the
+    // offsets announcement the first block makes.
+    std::vector<std::string> run(const std::vector<std::string>& lines) {
+        const std::size_t from = rec.all.size();
+        int n = 0;
+        for (const auto& l : lines) exec->execute(blk(l, ++n));
+        std::vector<std::string> out;
+        for (std::size_t i = from; i < rec.all.size(); ++i) {
+            std::string t = to_text(rec.all[i].cmd);
+            if (t.rfind("offsets ", 0) == 0 && !keep_offsets) continue;
+            out.push_back(t);
+        }
+        return out;
+    }
+    std::string error_of(const std::string& line) {
+        try {
+            exec->execute(blk(line, 7));
+        } catch (const Error& e) {
+            return e.what();
+        }
+        return "no error";
+    }
+
+    Recorder rec;
+    std::unique_ptr<Executor> exec;
+    bool keep_offsets = false;
+};
+
+using V = std::vector<std::string>;
+
+TEST_F(ExecTest, G00_2_RapidSplitsZUpFirstAndZDownLast) {
+    EXPECT_EQ(run({"G00 X10 Y20 Z5"}), (V{"traverse X0 Y0 Z5", "traverse X10 Y20 Z5"}));
+    EXPECT_EQ(run({"G00 X30 Y40 Z-2"}), (V{"traverse X30 Y40 Z5", "traverse X30 Y40 Z-2"}));
+    EXPECT_EQ(run({"G00 X0 Y0"}), (V{"traverse X0 Y0 Z-2"}));
+    EXPECT_EQ(run({"G00 Z3"}), (V{"traverse X0 Y0 Z3"}));
+}
+
+TEST_F(ExecTest, G00_2_SplitCanBeSwitchedOff) {
+    BackendConfig cfg;
+    cfg.g00_z_split = false;
+    make(cfg);
+    EXPECT_EQ(run({"G00 X10 Y20 Z5"}), (V{"traverse X10 Y20 Z5"}));
+}
+
+TEST_F(ExecTest, G00_3_FInRapidBlockSetsRapidOnly) {
+    // F600 mm/min = 10 mm/s. The first F also primes the cutting feed (REC).
+    EXPECT_EQ(run({"G00 X1 F600"}),
+              (V{"rapid-rate 10mm/s", "feed-rate 10mm/s", "traverse X1 Y0 Z0"}));
+    EXPECT_EQ(run({"G00 X2 F1200"}), (V{"rapid-rate 20mm/s", "traverse X2 Y0 Z0"}));
+    EXPECT_EQ(run({"G01 X3"}), (V{"feed X3 Y0 Z0"}));
+    EXPECT_DOUBLE_EQ(exec->state().feed.feed_mm_s, 10.0);
+    EXPECT_EQ(run({"G01 X4 F300"}), (V{"feed-rate 5mm/s", "feed X4 Y0 Z0"}));
+}
+
+TEST_F(ExecTest, G01_2_FeedMoveWithoutFeedIsAnError) {
+    EXPECT_EQ(error_of("G01 X10"), "test.nc:7:1: no feed rate programmed (F) for a feed move");
+}
+
+TEST_F(ExecTest, ARC_EX08_QuarterArcByIJAndByRAreIdentical) {
+    run({"G00 X10 Y20", "G01 F100"});
+    // From (10,20) clockwise to (20,10) about (10,10).
+    EXPECT_EQ(run({"G02 X20 Y10 I0 J-10"}), (V{"arc XY turns=-1 X20 Y10 Z0 centre=(10 10 0)"}));
+    run({"G00 X10 Y20"});
+    EXPECT_EQ(run({"G02 X20 Y10 R10"}), (V{"arc XY turns=-1 X20 Y10 Z0 centre=(10 10 0)"}));
+    // 1(b): from (20,10) counter-clockwise to (10,20), same centre.
+    EXPECT_EQ(run({"G03 X10 Y20 I-10 J0"}), (V{"arc XY turns=1 X10 Y20 Z0 centre=(10 10 0)"}));
+}
+
+TEST_F(ExecTest, ARC_EX08_FullCircleAndTwoHalfArcs) {
+    run({"G01 F100"});
+    EXPECT_EQ(run({"G02 X0 Y0 I20 J0"}), (V{"arc XY turns=-1 X0 Y0 Z0 centre=(20 0 0)"}));
+    // R-20 from (0,0) to (20,-20): the long way round about (20,0) (radius 20, 270° CW).
+    EXPECT_EQ(run({"G02 X20 Y-20 R-20"}), (V{"arc XY turns=-1 X20 Y-20 Z0 centre=(20 0 0)"}));
+    EXPECT_EQ(run({"G02 X0 Y0 R20"}), (V{"arc XY turns=-1 X0 Y0 Z0 centre=(20 0 0)"}));
+}
+
+TEST_F(ExecTest, ARC_4_FullCircleWithROrNoCentreIsAnError) {
+    run({"G01 F100"});
+    EXPECT_EQ(error_of("G02 X0 Y0 R20"),
+              "test.nc:7:1: a full circle cannot be programmed with R; use I/J/K");
+    EXPECT_EQ(error_of("G02 X10 Y0"), "test.nc:7:1: arc needs R or I/J/K");
+}
+
+TEST_F(ExecTest, ARC_4_EndPointOmittedIsAFullCircle) {
+    run({"G00 X20 Y0", "G01 F500"});
+    EXPECT_EQ(run({"G03 I-20 J0"}), (V{"arc XY turns=1 X20 Y0 Z0 centre=(0 0 0)"}));
+}
+
+TEST_F(ExecTest, ARC_8_HelixAbsoluteAndIncrementalAgree) {
+    run({"G00 X30 Y0", "G01 F300"});
+    EXPECT_EQ(run({"G91 G17 G03 X-30 Y30 R30 Z10"}),
+              (V{"plane XY", "arc XY turns=1 X0 Y30 Z10 centre=(0 0 0)"}));
+    run({"G90 G00 X30 Y0 Z0"});
+    EXPECT_EQ(run({"G90 G03 X0 Y30 R30 Z10"}), (V{"arc XY turns=1 X0 Y30 Z10 centre=(0 0 0)"}));
+}
+
+TEST_F(ExecTest, ARC_1_PlanesZXAndYZUseKIAndJK) {
+    run({"G01 F100"});
+    // G18: (first, second) = (Z, X). From (0,0,0) CW to X20 about X10 (I10).
+    EXPECT_EQ(run({"G18 G02 X20 I10 K0"}), (V{"plane ZX", "arc ZX turns=-1 X20 Y0 Z0 centre=(10 0 0)"}));
+    // G19: (Y, Z). From Y0 Z0 CCW to Y0 Z10 about Z5 (K5).
+    EXPECT_EQ(run({"G19 G03 X20 Y0 Z10 J0 K5"}),
+              (V{"plane YZ", "arc YZ turns=1 X20 Y0 Z10 centre=(20 0 5)"}));
+}
+
+TEST_F(ExecTest, ARC_11_EndPointOffTheCircleIsAnError) {
+    run({"G01 F100"});
+    EXPECT_EQ(error_of("G02 X20 Y1 I10 J0"),
+              "test.nc:7:1: arc end point is not on the circle: radius 10 mm at the start, "
+              "10.0499 mm at the end (difference 0.0499 mm, tolerance 0.01 mm)");
+    // Within 0.01 mm is accepted.
+    EXPECT_NO_THROW(exec->execute(blk("G02 X20.005 Y0 I10 J0")));
+}
+
+TEST_F(ExecTest, ARC_3_RadiusTooSmallIsAnErrorExceptInV54) {
+    run({"G01 F100"});
+    EXPECT_EQ(error_of("G02 X20 Y0 R5"),
+              "test.nc:7:1: arc radius R5 is smaller than half the chord (10 mm)");
+    BackendConfig cfg;
+    cfg.v54_compat = true;
+    make(cfg);
+    run({"G01 F100"});
+    EXPECT_EQ(run({"G02 X20 Y0 R5"}), (V{"arc XY turns=-1 X20 Y0 Z0 centre=(10 0 0)"}));
+}
+
+TEST_F(ExecTest, ARC_9_V54HelixLeadAddsTurns) {
+    BackendConfig cfg;
+    cfg.v54_compat = true;
+    make(cfg);
+    run({"G00 X30 Y0", "G01 F300"});
+    // n = round(10/10 - 0.25) = 1 extra turn: a 450° sweep rising 10.
+    EXPECT_EQ(run({"G90 G17 G03 X0 Y30 R30 Z10 K10"}),
+              (V{"plane XY", "arc XY turns=2 X0 Y30 Z10 centre=(0 0 0)"}));
+}
+
+TEST_F(ExecTest, ARC_5_AbsoluteCentreSetting) {
+    BackendConfig cfg;
+    cfg.ijk_incremental = false;
+    make(cfg);
+    run({"G00 X10 Y20", "G01 F100"});
+    EXPECT_EQ(run({"G02 X20 Y10 I10 J10"}), (V{"arc XY turns=-1 X20 Y10 Z0 centre=(10 10 0)"}));
+}
+
+TEST_F(ExecTest, ABS_2_G90AndG91InOneBlockIsAnError) {
+    EXPECT_EQ(error_of("G90 G91 G00 X10"), "test.nc:7:5: G90 and G91 in the same block");
+}
+
+TEST_F(ExecTest, SameModalGroupIsAnError) {
+    EXPECT_EQ(error_of("G00 G01 X10"), "test.nc:7:5: G00 and G01 are in the same modal group");
+    EXPECT_EQ(error_of("M03 M05"), "test.nc:7:5: M03 and M05 are in the same modal group");
+}
+
+TEST_F(ExecTest, UnsupportedCodesAreNamed) {
+    EXPECT_EQ(error_of("G00 G33 X1"), "test.nc:7:5: unsupported G code G33");
+    EXPECT_EQ(error_of("G12.1"), "test.nc:7:1: unsupported G code G12.1");
+    EXPECT_EQ(error_of("M19"), "test.nc:7:1: unsupported M code M19");
+}
+
+TEST_F(ExecTest, TwoAxisUsersInOneBlockIsAnError) {
+    EXPECT_EQ(error_of("G92 G01 X10"), "test.nc:7:5: G92 and G01 both use the axis words");
+}
+
+TEST_F(ExecTest, RejectedBlockChangesNothing) {
+    run({"G00 X5 Y5", "G01 F100"});
+    const ExecState before = exec->state();
+    const std::size_t n = rec.all.size();
+    // Units, feed, spindle and plane would change before the bad arc fails.
+    EXPECT_NE(error_of("G20 G18 F50 S900 M03 G51 X0 P0"), "no error");
+    EXPECT_NE(error_of("G20 S900 M03 G02 X20 Y1 I10 J0"), "no error");
+    EXPECT_EQ(rec.all.size(), n);
+    EXPECT_EQ(exec->state().units.mm_per_unit, before.units.mm_per_unit);
+    EXPECT_EQ(exec->state().spindle.rpm, before.spindle.rpm);
+    EXPECT_EQ(exec->state().spindle.dir, before.spindle.dir);
+    EXPECT_EQ(exec->state().pos.machine_mm, before.pos.machine_mm);
+    EXPECT_TRUE(exec->transform().identity());
+}
+
+TEST_F(ExecTest, UNIT_1_InchInputIsConvertedToMm) {
+    EXPECT_EQ(run({"G20 G00 X1 Y2"}), (V{"units inch", "traverse X25.4 Y50.8 Z0"}));
+    EXPECT_EQ(run({"G70 G01 X2 F10"}),
+              (V{"units inch", "feed-rate 4.2333mm/s", "feed X50.8 Y50.8 Z0"}));
+    EXPECT_EQ(run({"G71 G00 X1"}), (V{"units mm", "traverse X1 Y50.8 Z0"}));
+}
+
+TEST_F(ExecTest, ABS_1_IncrementalMoves) {
+    EXPECT_EQ(run({"G91 G00 X10", "X10 Y5"}), (V{"traverse X10 Y0 Z0", "traverse X20 Y5 Z0"}));
+}
+
+TEST_F(ExecTest, DW_1_DwellPInMilliseconds) {
+    EXPECT_EQ(run({"G04 P1000"}), (V{"dwell 1s"}));
+    EXPECT_EQ(run({"G04 P2500"}), (V{"dwell 2.5s"}));
+    EXPECT_EQ(error_of("G04"), "test.nc:7:1: G04 needs P<milliseconds>");
+    EXPECT_EQ(error_of("G04 P-5"), "test.nc:7:1: G04: negative dwell time");
+}
+
+TEST_F(ExecTest, WCS_1_WorkOffsetsSelectAndPersist) {
+    Settings s;
+    s.offsets.wcs[1] = {100, 50, -10, 0, 0, 0};
+    make({}, s);
+    keep_offsets = true;
+    EXPECT_EQ(run({"G55"}), (V{"offsets G54 origin=(X0 Y0 Z0) shift=(X0 Y0 Z0)",
+                               "offsets G55 origin=(X100 Y50 Z-10) shift=(X0 Y0 Z0)"}));
+    keep_offsets = false;
+    EXPECT_EQ(run({"G00 X1 Y1"}), (V{"traverse X101 Y51 Z0"}));
+    // CS-3: a G54 switch does not move; the next move goes to G54 coordinates, and an axis that
+    // is not written stays where the machine is.
+    EXPECT_EQ(run({"G54", "G00 X1"}), (V{"traverse X1 Y51 Z0"}));
+}
+
+TEST_F(ExecTest, G92_2_ShiftMovesEveryWorkSystemAndPersists) {
+    Settings s;
+    s.offsets.wcs[1] = {100, 0, 0, 0, 0, 0};
+    make({}, s);
+    int saved = 0;
+    exec->on_settings_changed([&](const Settings&) { ++saved; });
+    run({"G00 X10 Y10", "G92 X0 Y0"});
+    EXPECT_EQ(saved, 1);
+    EXPECT_EQ(exec->settings().offsets.g92[0], 10);
+    EXPECT_EQ(run({"G00 X5"}), (V{"traverse X15 Y10 Z0"}));
+    EXPECT_EQ(run({"G55 G00 X5"}), (V{"traverse X115 Y10 Z0"}));
+    EXPECT_DOUBLE_EQ(exec->work_pos_mm(Axis::X), 5);
+    // Program end keeps it (G92-3).
+    run({"M30"});
+    EXPECT_EQ(exec->settings().offsets.g92[0], 10);
+}
+
+TEST_F(ExecTest, G921_1_SetsOnlyTheCurrentWorkSystem) {
+    run({"G00 X10 Y10", "G921 X0"});
+    EXPECT_EQ(exec->settings().offsets.wcs[0][0], 10);
+    EXPECT_EQ(exec->settings().offsets.wcs[1][0], 0);
+    EXPECT_EQ(exec->settings().offsets.g92[0], 0);
+}
+
+TEST_F(ExecTest, G922_1_WritesOriginsInMachineCoordinates) {
+    run({"G922 X5 Y6 P1", "G922 Z-3 P-4", "G922 X7"});
+    EXPECT_EQ(exec->settings().offsets.wcs[1][0], 5);
+    EXPECT_EQ(exec->settings().offsets.wcs[1][1], 6);
+    EXPECT_EQ(exec->settings().offsets.common[2], -3);
+    EXPECT_EQ(exec->settings().offsets.wcs[0][0], 7);
+    EXPECT_EQ(error_of("G922 X1 P6"), "test.nc:7:9: G922 offset type: P6 must be an integer in -4..5");
+    EXPECT_EQ(error_of("G922 X1 P-2"), "test.nc:7:9: G922: P must be -4, -1 or 0..5");
+}
+
+TEST_F(ExecTest, G923_1_WritesToolOffsets) {
+    run({"G923 Z2.392 P1", "T1", "G923 X0.5"});
+    ASSERT_NE(exec->settings().tools.find(1), nullptr);
+    EXPECT_DOUBLE_EQ(exec->settings().tools.find(1)->offset_mm[2], 2.392);
+    EXPECT_DOUBLE_EQ(exec->settings().tools.find(1)->offset_mm[0], 0.5);
+    make();
+    EXPECT_EQ(error_of("G923 Z1"), "test.nc:7:1: G923: no current tool; give P<tool>");
+}
+
+TEST_F(ExecTest, G992_1_TemporarySystemIsRestoredAtProgramEnd) {
+    run({"G00 X30 Y40", "G992 X0 Y0", "G00 X10"});
+    EXPECT_DOUBLE_EQ(exec->state().pos.machine_mm[0], 40);
+    // G992-2: I J K shift the temporary system.
+    run({"G992 I5", "G00 X0 Y0"});
+    EXPECT_DOUBLE_EQ(exec->state().pos.machine_mm[0], 35);
+    EXPECT_DOUBLE_EQ(exec->state().pos.machine_mm[1], 40);
+    EXPECT_EQ(error_of("G92 X0"),
+              "test.nc:7:1: G92 is not allowed while a G992 temporary system is active");
+    run({"M02"});
+    EXPECT_EQ(exec->state().coord.g992_mm, AxisVec{});
+    EXPECT_EQ(exec->settings().offsets, WorkOffsets{});
+}
+
+TEST_F(ExecTest, SCL_EX03_ScalingAboutACentre) {
+    run({"G00 X50 Y50", "G51 X100 Y80 P0.5"});
+    EXPECT_EQ(run({"G01 Y150 F1000", "X175 Y50", "G90 X50", "G50", "G00 X0 Y0"}),
+              (V{"feed-rate 16.6667mm/s", "feed X75 Y115 Z0", "feed X137.5 Y65 Z0",
+                 "feed X75 Y65 Z0", "traverse X0 Y0 Z0"}));
+}
+
+TEST_F(ExecTest, SCL_2_UnlistedAxesKeepTheirFactor) {
+    run({"G51 X0 Y0 P2", "G51 Z0 P3", "G00 X1 Y1 Z1"});
+    EXPECT_EQ(exec->state().pos.machine_mm, (AxisVec{2, 2, 3, 0, 0, 0}));
+}
+
+TEST_F(ExecTest, SCL_3_BadFactorsAreErrors) {
+    EXPECT_EQ(error_of("G51 X0 P0"), "test.nc:7:8: G51: scale factor P is 0");
+    EXPECT_EQ(error_of("G51 X0 P100"),
+              "test.nc:7:8: G51: scale factor P100 outside 0.000001..99.999999");
+    EXPECT_EQ(error_of("G51 X0 P2 I2"), "test.nc:7:1: G51: use either P or I/J/K, not both");
+    EXPECT_EQ(error_of("G51 X0"), "test.nc:7:1: G51 needs P<factor> or I/J/K factors");
+    EXPECT_EQ(error_of("G51 P2"),
+              "test.nc:7:1: G51 P scales the axes written in the block; none given");
+}
+
+TEST_F(ExecTest, SCL_1_PerAxisFactorsIJK) {
+    run({"G51 X0 Y0 I0.666666 J3", "G00 X3 Y1"});
+    EXPECT_NEAR(exec->state().pos.machine_mm[0], 1.999998, 1e-9);
+    EXPECT_NEAR(exec->state().pos.machine_mm[1], 3, 1e-9);
+}
+
+TEST_F(ExecTest, SCL_8_ForbiddenCodesWhileScaling) {
+    run({"G51 X0 Y0 P2"});
+    EXPECT_EQ(error_of("G28 X0"), "test.nc:7:1: G28 is not allowed while scaling (G51) is active");
+    EXPECT_EQ(error_of("G53 G00 X0"),
+              "test.nc:7:1: G53 is not allowed while scaling (G51) is active");
+    EXPECT_EQ(error_of("G92 X0"), "test.nc:7:1: G92 is not allowed while scaling (G51) is active");
+}
+
+TEST_F(ExecTest, SCL_9_ScalingRotationMirrorEndWithTheProgram) {
+    run({"G51 X0 Y0 P2", "G68 X0 Y0 R30", "G51.1 X0", "M30"});
+    EXPECT_TRUE(exec->transform().identity());
+}
+
+TEST_F(ExecTest, ARC_15_NonUniformScalingOfArcIsAnError) {
+    run({"G01 F100", "G51 X0 Y0 I1 J2"});
+    EXPECT_EQ(error_of("G02 X20 Y0 I10 J0"),
+              "test.nc:7:1: non-uniform scaling of arc (different G51 factors on the plane axes)");
+}
+
+TEST_F(ExecTest, ROT_EX04_RectangleRotatedMinus90) {
+    run({"G01 F100", "G68 X0 Y0 R-90"});
+    EXPECT_EQ(run({"G91 G01 X100", "Y50", "X-100", "Y-50", "G90"}),
+              (V{"feed X0 Y-100 Z0", "feed X50 Y-100 Z0", "feed X50 Y0 Z0", "feed X0 Y0 Z0"}));
+    run({"G69"});
+    EXPECT_TRUE(exec->transform().identity());
+}
+
+TEST_F(ExecTest, ROT_3_NestedCentreIsInTheRotatedFrame) {
+    // A: 90° about the origin. B: 90° about (10,0) written in A's frame, i.e. about (0,10).
+    run({"G68 X0 Y0 R90", "G68 X10 Y0 R90", "G00 X10 Y0"});
+    // Inner first: (10,0) about (10,0) stays (10,0); then A: (0,10).
+    EXPECT_NEAR(exec->state().pos.machine_mm[0], 0, 1e-9);
+    EXPECT_NEAR(exec->state().pos.machine_mm[1], 10, 1e-9);
+    run({"G00 X0 Y0"});
+    // (0,0) about (10,0) by 90° -> (10,-10); then A -> (10,10).
+    EXPECT_NEAR(exec->state().pos.machine_mm[0], 10, 1e-9);
+    EXPECT_NEAR(exec->state().pos.machine_mm[1], 10, 1e-9);
+    // ROT-4: G69 pops B only; (0,0) under A alone stays (0,0), (10,0) -> (0,10).
+    run({"G69", "G00 X10 Y0"});
+    EXPECT_NEAR(exec->state().pos.machine_mm[0], 0, 1e-9);
+    EXPECT_NEAR(exec->state().pos.machine_mm[1], 10, 1e-9);
+    EXPECT_EQ(exec->transform().size(), 1u);
+}
+
+TEST_F(ExecTest, ROT_2_RotationInZXKeepsY) {
+    run({"G18 G68 X0 Z0 R90", "G00 Z10 Y3"});
+    // In ZX (first Z, second X), +90° turns +Z into +X.
+    EXPECT_NEAR(exec->state().pos.machine_mm[0], 10, 1e-9);
+    EXPECT_NEAR(exec->state().pos.machine_mm[1], 3, 1e-9);
+    EXPECT_NEAR(exec->state().pos.machine_mm[2], 0, 1e-9);
+}
+
+TEST_F(ExecTest, MIR_1_MirrorLineAndArcDirectionFlip) {
+    run({"G01 F100", "G51.1 X10", "G00 X0 Y0"});
+    EXPECT_NEAR(exec->state().pos.machine_mm[0], 20, 1e-9);
+    // G02 about (10,0) prog -> machine centre (10,0), direction now CCW (ARC-14).
+    EXPECT_EQ(run({"G02 X20 Y0 I10 J0"}), (V{"arc XY turns=1 X0 Y0 Z0 centre=(10 0 0)"}));
+    run({"G50.1 X0", "G00 X1"});
+    EXPECT_NEAR(exec->state().pos.machine_mm[0], 1, 1e-9);
+    EXPECT_EQ(error_of("G51.1"), "test.nc:7:1: G51.1 needs the mirror axes (X Y Z)");
+}
+
+TEST_F(ExecTest, MIR_1_MirrorThroughAPoint) {
+    run({"G51.1 X10 Y10 Z10", "G00 X0 Y0 Z0"});
+    EXPECT_EQ(exec->state().pos.machine_mm, (AxisVec{20, 20, 20, 0, 0, 0}));
+}
+
+TEST_F(ExecTest, TLC_EX11_LengthOffsetAddsToZ) {
+    Settings s;
+    s.tools.at(1).offset_mm = {0, 0, 12.5};
+    make({}, s);
+    run({"G90 G00 X5 Z0 F300"});
+    EXPECT_EQ(run({"G43 G00 Z10 H01"}), (V{"tool-offset X0 Y0 Z12.5", "traverse X5 Y0 Z22.5"}));
+    EXPECT_EQ(run({"G01 Z-10 F1000"}), (V{"feed-rate 16.6667mm/s", "feed X5 Y0 Z2.5"}));
+    EXPECT_EQ(run({"G44 H1"}), (V{"tool-offset X0 Y0 Z-12.5"}));
+    EXPECT_EQ(run({"G49"}), (V{"tool-offset X0 Y0 Z0"}));
+    EXPECT_EQ(error_of("G43 H5"),
+              "test.nc:7:5: tool length compensation: tool 5 is not in the tool table");
+}
+
+TEST_F(ExecTest, TLC_7_WithoutHTheCurrentToolIsUsed) {
+    Settings s;
+    s.tools.at(2).offset_mm = {0, 0, 7};
+    make({}, s);
+    EXPECT_EQ(run({"G43", "T2"}), (V{"tool-offset X0 Y0 Z0", "tool-change T2", "tool-offset X0 Y0 Z7"}));
+}
+
+TEST_F(ExecTest, M03_1_SpindleSpeedIsKeptWhileStopped) {
+    EXPECT_EQ(run({"S500 M03", "M05", "M04"}),
+              (V{"spindle-speed 500rpm", "spindle cw", "spindle stop", "spindle ccw"}));
+    EXPECT_DOUBLE_EQ(exec->spindle_rpm(), 500);
+    EXPECT_EQ(error_of("S-5"), "test.nc:7:1: negative spindle speed S-5");
+}
+
+TEST_F(ExecTest, M08_1_Coolant) { EXPECT_EQ(run({"M08", "M09"}), (V{"coolant on", "coolant off"})); }
+
+TEST_F(ExecTest, M10_1_ClampIsAWarningIn6thAndACommandInV54) {
+    EXPECT_EQ(run({"M10"}),
+              (V{"warning \"M10 is an invalid instruction in NcStudio 6th edition; ignored\""}));
+    BackendConfig cfg;
+    cfg.v54_compat = true;
+    make(cfg);
+    EXPECT_EQ(run({"M10", "M11"}), (V{"spindle-clamp on", "spindle-clamp off"}));
+}
+
+TEST_F(ExecTest, M06_1_TChangesToolAndM06FollowsV54) {
+    EXPECT_EQ(run({"T3 M06"}), (V{"tool-change T3"}));
+    BackendConfig cfg;
+    cfg.t_changes_tool = false;
+    make(cfg);
+    EXPECT_EQ(run({"T4", "M06"}), (V{"tool-change T4"}));
+}
+
+TEST_F(ExecTest, M903_1_ChangesTheToolNumberOnly) {
+    EXPECT_EQ(run({"M903 T5"}), (V{"tool-number T5"}));
+    EXPECT_EQ(run({"M903 P6"}), (V{"tool-number T6"}));
+    EXPECT_EQ(error_of("M903"), "test.nc:7:1: M903 needs T<tool> (or P<tool>)");
+}
+
+TEST_F(ExecTest, M01_1_OptionalStopFollowsTheSwitch) {
+    EXPECT_EQ(run({"M00", "M01"}), (V{"stop"}));
+    BackendConfig cfg;
+    cfg.optional_stop = true;
+    make(cfg);
+    EXPECT_EQ(run({"M01"}), (V{"optional-stop"}));
+}
+
+TEST_F(ExecTest, M30_1_EndResetsModalStateAndStopsSpindle) {
+    run({"G91 G20 G18 S100 M03 M08"});
+    keep_offsets = true;
+    EXPECT_EQ(run({"M30"}), (V{"spindle stop", "coolant off",
+                               "offsets G54 origin=(X0 Y0 Z0) shift=(X0 Y0 Z0)",
+                               "program-end rewind"}));
+    EXPECT_FALSE(exec->state().motion.incremental);
+    EXPECT_EQ(exec->state().units.mm_per_unit, 1.0);
+    EXPECT_EQ(exec->state().motion.plane, Plane::XY);
+    EXPECT_EQ(run({"M02"}).back(), "program-end");
+}
+
+TEST_F(ExecTest, REF_2_G28ThroughIntermediatePoint) {
+    BackendConfig cfg;
+    cfg.reference_mm = {0, 0, 50, 0, 0, 0};
+    make(cfg);
+    run({"G00 X10 Y10 Z5"});
+    // Intermediate (20, -, 10): Z rises first; then Z to the reference 50 alone with X to 0.
+    EXPECT_EQ(run({"G28 X20 Z10"}),
+              (V{"traverse X10 Y10 Z10", "traverse X20 Y10 Z10", "traverse X20 Y10 Z50",
+                 "traverse X0 Y10 Z50"}));
+    EXPECT_EQ(error_of("G28"), "test.nc:7:1: G28 needs the axes to return (X Y Z)");
+}
+
+TEST_F(ExecTest, MCS_1_G53MovesInMachineCoordinates) {
+    Settings s;
+    s.offsets.wcs[0] = {100, 100, 0, 0, 0, 0};
+    make({}, s);
+    EXPECT_EQ(run({"G53 G00 X5 Y6"}), (V{"traverse X5 Y6 Z0"}));
+    // Non-modal: the next move is in G54 again.
+    EXPECT_EQ(run({"G00 X0"}), (V{"traverse X100 Y6 Z0"}));
+    EXPECT_EQ(error_of("G91 G53 G00 X1"), "test.nc:7:5: G53 needs absolute coordinates (G90)");
+}
+
+TEST_F(ExecTest, M801_M802_Messages) {
+    Block b = blk("M801");
+    b.msg = "Hello";
+    exec->execute(b);
+    EXPECT_EQ(to_text(rec.all.back().cmd), "message \"Hello\"");
+    EXPECT_EQ(run({"M802 P196609"}), (V{"int-message 196609"}));
+    EXPECT_EQ(error_of("M801"), "test.nc:7:1: M801 needs MSG \"text\"");
+    EXPECT_EQ(error_of("M802"), "test.nc:7:1: M802 needs P<integer message>");
+}
+
+TEST_F(ExecTest, M901_1_BothOutputForms) {
+    Block b = blk("M901");
+    b.kw.plc = 4;
+    b.kw.level = 1;
+    exec->execute(b);
+    EXPECT_EQ(to_text(rec.all.back().cmd), "set-output PLC4 1");
+    EXPECT_EQ(run({"M901 H2 P1", "M901 H24 P0"}), (V{"set-output H2 1", "set-output H24 0"}));
+    EXPECT_EQ(exec->output_bits(), (1u << 2) | (1u << 4));
+    EXPECT_EQ(error_of("M901 H2"),
+              "test.nc:7:1: M901 needs PLC[addr] LEVEL<0|1> or H<port> P<0|1>");
+}
+
+TEST_F(ExecTest, M902_1_HomingSetsTheMachineCoordinate) {
+    BackendConfig cfg;
+    cfg.home_position_mm = {-5, 0, 0, 0, 0, 0};
+    make(cfg);
+    run({"G00 X30"});
+    EXPECT_EQ(run({"M902 H0"}), (V{"home-done X at=-5"}));
+    EXPECT_DOUBLE_EQ(exec->machine_pos_mm(Axis::X), -5);
+    EXPECT_EQ(error_of("M902 H4"), "test.nc:7:6: M902 axis: H4 must be an integer in 0..3");
+}
+
+TEST_F(ExecTest, NCX_3_G904ConditionalMove) {
+    Block b = blk("G904");
+    b.kw.f_axis[2] = -60;
+    b.kw.p_axis[2] = 12;
+    b.kw.l_axis[2] = 1;
+    exec->execute(b);
+    EXPECT_EQ(to_text(rec.all.back().cmd), "conditional-move Z:speed=-1mm/s,input=12,level=1");
+    Block bad = blk("G904", 7);
+    bad.kw.f_axis[0] = 100;
+    EXPECT_THROW(
+        {
+            try {
+                exec->execute(bad);
+            } catch (const Error& e) {
+                EXPECT_STREQ(e.what(), "test.nc:7:1: G904: axis X needs FX, PX and LX");
+                throw;
+            }
+        },
+        Error);
+    EXPECT_EQ(error_of("G904"), "test.nc:7:1: G904 needs at least one axis (FX PX LX …)");
+}
+
+TEST_F(ExecTest, NCX_4_G904V54Form) {
+    BackendConfig cfg;
+    cfg.v54_compat = true;
+    make(cfg);
+    EXPECT_EQ(run({"G904 Z-120 K3 H0"}), (V{"conditional-move Z:speed=-2mm/s,input=3,level=0"}));
+}
+
+TEST_F(ExecTest, NCX_5_6_G906SyncAndWait) {
+    EXPECT_EQ(run({"G906"}), (V{"sync"}));
+    Block b = blk("G906 P1000");
+    b.kw.plc = 4;
+    b.kw.level = 1;
+    exec->execute(b);
+    EXPECT_EQ(to_text(rec.all.back().cmd), "wait-input PLC4 level=1 timeout=1s");
+    EXPECT_EQ(error_of("G906 P1000"),
+              "test.nc:7:1: G906 with a port needs PLC[addr] LEVEL<0|1> P<timeout ms>");
+}
+
+TEST_F(ExecTest, NCX_9_10_11_Latch) {
+    Block b = blk("G916");
+    b.kw.p_axis[0] = 0;
+    b.kw.l_axis[0] = 0;
+    exec->execute(b);
+    EXPECT_EQ(to_text(rec.all.back().cmd), "latch-config X input=0 level=0");
+    EXPECT_EQ(run({"G918", "G919 H0"}), (V{"latch-clear", "latch-stop-distance X"}));
+    EXPECT_EQ(error_of("G916"), "test.nc:7:1: G916 needs PX[addr] LX<0|1> (or Y/Z)");
+    EXPECT_EQ(error_of("G919"), "test.nc:7:1: G919 needs H<axis> (0=X 1=Y 2=Z)");
+}
+
+TEST_F(ExecTest, NCX_1_2_7_8_MoveFlags) {
+    EXPECT_EQ(run({"G905 G903 G01 X10 Y20 Z0 F600"}),
+              (V{"feed-rate 10mm/s", "feed X10 Y20 Z0 override=100% programmed-feed"}));
+    EXPECT_EQ(run({"G907 G908 G00 A90"}),
+              (V{"traverse X10 Y20 Z0 A90 rotary-shortest rotary-degrees"}));
+    // Non-modal.
+    EXPECT_EQ(run({"G01 X0"}), (V{"feed X0 Y20 Z0 A90"}));
+}
+
+TEST_F(ExecTest, CS_2_MachineQueryAnswersFromTheModel) {
+    Settings s;
+    s.offsets.wcs[0] = {10, 20, 30, 0, 0, 0};
+    s.params["MOBICALI_THICKNESS"] = 12;
+    BackendConfig cfg;
+    cfg.machine_settings["SAFEHEIGHT"] = 40;
+    make(cfg, s);
+    run({"G20 G00 X1 Y2 Z3"});
+    EXPECT_NEAR(exec->machine_pos_mm(Axis::X), 35.4, 1e-9);
+    EXPECT_NEAR(exec->work_pos_mm(Axis::Z), 76.2, 1e-9);
+    EXPECT_DOUBLE_EQ(exec->mm_per_program_unit(), 25.4);
+    EXPECT_EQ(exec->setting("MOBICALI_THICKNESS"), 12.0);
+    EXPECT_EQ(exec->setting("SAFEHEIGHT"), 40.0);
+    EXPECT_EQ(exec->setting("NOPE"), std::nullopt);
+}
+
+TEST_F(ExecTest, EndOfInputEndsTheProgram) {
+    run({"G51 X0 Y0 P2"});
+    exec->end_of_input(SourceLoc{"test.nc", 9, 1});
+    EXPECT_EQ(to_text(rec.all.back()), "9 program-end");
+    EXPECT_TRUE(exec->transform().identity());
+}
+
+}  // namespace
+}  // namespace interp

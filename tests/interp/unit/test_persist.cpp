@@ -1,0 +1,132 @@
+// Persistent settings and LinuxCNC tool tables: round trips, atomic replacement, and one test
+// per error message.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "interp/block.hpp"
+#include "interp/persist.hpp"
+#include "interp/tooltable.hpp"
+
+namespace interp {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string error_of_settings(const std::string& text) {
+    try {
+        parse_settings(text, "s.txt");
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+std::string error_of_tbl(const std::string& text) {
+    try {
+        parse_linuxcnc_tool_table(text, "t.tbl");
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+fs::path temp_dir() {
+    // Unique per process so ctest -j can run this alongside other tests.
+    fs::path d = fs::temp_directory_path() / ("iback-persist-" + std::to_string(::getpid()));
+    fs::create_directories(d);
+    return d;
+}
+
+TEST(Settings, RoundTripThroughTheFile) {
+    Settings s;
+    s.offsets.wcs[2] = {1.5, -2.25, 3, 0, 0, 90};
+    s.offsets.common = {0, 0, -0.1, 0, 0, 0};
+    s.offsets.g92 = {10, 20, 0, 0, 0, 0};
+    s.tools.at(3).offset_mm = {0.1, 0.2, 12.345678901};
+    s.tools.at(3).diameter_mm = 6;
+    s.params["FIXEDCALI_REC"] = -12.75;
+    const fs::path dir = temp_dir();
+    const std::string path = (dir / "settings.txt").string();
+    save_settings_atomic(path, s);
+    EXPECT_FALSE(fs::exists(path + ".tmp"));
+    const Settings back = load_settings(path);
+    EXPECT_EQ(back, s);
+    // Replacing keeps exactly one complete file.
+    s.offsets.g92[0] = 11;
+    save_settings_atomic(path, s);
+    EXPECT_EQ(load_settings(path), s);
+    fs::remove_all(dir);
+}
+
+TEST(Settings, MissingFileGivesDefaults) {
+    EXPECT_EQ(load_settings("/nonexistent-dir-iback/settings.txt"), Settings{});
+}
+
+TEST(Settings, SaveIntoMissingDirectoryFailsAndNamesThePath) {
+    try {
+        save_settings_atomic("/nonexistent-dir-iback/settings.txt", Settings{});
+        FAIL() << "no error";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("/nonexistent-dir-iback/settings.txt.tmp"),
+                  std::string::npos);
+    }
+}
+
+TEST(Settings, ErrorsNameFileLineAndColumn) {
+    EXPECT_EQ(error_of_settings("# ok\nwcs 1 0 0 0 0 0\n"),
+              "s.txt:2:1: settings: 'wcs' needs 7 values, found 6");
+    EXPECT_EQ(error_of_settings("wcs 7 0 0 0 0 0 0\n"),
+              "s.txt:1:5: settings: '7' must be an integer in 1..6");
+    EXPECT_EQ(error_of_settings("g92 0 0 x 0 0 0\n"), "s.txt:1:9: settings: 'x' is not a number");
+    EXPECT_EQ(error_of_settings("tool 1 0 0 5 -1\n"), "s.txt:1:14: settings: negative tool diameter");
+    EXPECT_EQ(error_of_settings("bogus 1\n"), "s.txt:1:1: settings: unknown entry 'bogus'");
+}
+
+TEST(Settings, BadFileOnDiskIsReportedAndLeftAlone) {
+    const fs::path dir = temp_dir();
+    const std::string path = (dir / "bad.txt").string();
+    {
+        std::ofstream f(path);
+        f << "common 1 2 3\n";
+    }
+    EXPECT_THROW(load_settings(path), Error);
+    std::ifstream f(path);
+    std::string line;
+    std::getline(f, line);
+    EXPECT_EQ(line, "common 1 2 3");
+    fs::remove_all(dir);
+}
+
+TEST(ToolTable, ReadsLinuxCncLines) {
+    const ToolTable t = parse_linuxcnc_tool_table(
+        "T1 P1 D6.0 Z12.5 ;six mm end mill\n\nt2 p2 d3 z+7 x0.5 ; drill\nT3 P3 ;\n", "t.tbl");
+    ASSERT_NE(t.find(1), nullptr);
+    EXPECT_DOUBLE_EQ(t.find(1)->diameter_mm, 6.0);
+    EXPECT_DOUBLE_EQ(t.find(1)->offset_mm[2], 12.5);
+    EXPECT_EQ(t.find(1)->comment, "six mm end mill");
+    EXPECT_EQ(t.find(1)->pocket, 1);
+    ASSERT_NE(t.find(2), nullptr);
+    EXPECT_DOUBLE_EQ(t.find(2)->offset_mm[0], 0.5);
+    EXPECT_DOUBLE_EQ(t.find(2)->offset_mm[2], 7);
+    ASSERT_NE(t.find(3), nullptr);
+    EXPECT_EQ(t.find(4), nullptr);
+}
+
+TEST(ToolTable, OneTestPerErrorMessage) {
+    EXPECT_EQ(error_of_tbl("T1 P1 Dx\n"), "t.tbl:1:8: tool table: expected a number after 'D'");
+    EXPECT_EQ(error_of_tbl("T1.5 P1\n"), "t.tbl:1:1: tool table: bad tool number");
+    EXPECT_EQ(error_of_tbl("T1 D-2\n"), "t.tbl:1:4: tool table: negative diameter");
+    EXPECT_EQ(error_of_tbl("T1 R2\n"), "t.tbl:1:4: tool table: unknown word 'R'");
+    EXPECT_EQ(error_of_tbl("P1 D2\n"), "t.tbl:1:1: tool table: line has no T word");
+    EXPECT_EQ(error_of_tbl("T1 P1\nT1 P2\n"), "t.tbl:2:1: tool table: tool 1 listed twice");
+}
+
+TEST(ToolTable, MissingFileIsAnError) {
+    EXPECT_THROW(load_linuxcnc_tool_table("/nonexistent-dir-iback/x.tbl"), Error);
+}
+
+}  // namespace
+}  // namespace interp
