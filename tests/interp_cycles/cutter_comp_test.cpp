@@ -1,1 +1,327 @@
+// Cutter radius compensation: hand-computed offset paths for small contours,
+// the manual's two programs (S0 §3.5.3), and every error.
+//
+// Expected geometry is derived by hand: a line offset to the left by r moves
+// by r along (−dy, dx)/|d|; an inside corner of two axis-parallel lines is the
+// crossing of the two shifted lines; an outside corner is a quarter arc of
+// radius r about the programmed corner.
+
+#include "interp/cutter_comp.hpp"
+
+#include <fmt/format.h>
 #include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace {
+
+using namespace interp::cutter;
+using Lines = std::vector<std::string>;
+
+double clean(double v) {
+    const double r = std::round(v * 1e6) / 1e6;
+    return r == 0 ? 0 : r;
+}
+
+const char* role_name(Role r) {
+    switch (r) {
+        case Role::Plain:
+            return "plain";
+        case Role::Startup:
+            return "startup";
+        case Role::Contour:
+            return "contour";
+        case Role::Corner:
+            return "corner";
+        case Role::Cancel:
+            return "cancel";
+        case Role::Height:
+            return "height";
+    }
+    return "?";
+}
+
+std::string describe(const Output& o) {
+    if (const auto* m = std::get_if<OutMove>(&o)) {
+        std::string s = fmt::format("{} {:g},{:g} -> {:g},{:g}",
+                                    m->shape == Shape::Line ? "L" : "A", clean(m->start.x()),
+                                    clean(m->start.y()), clean(m->end.x()), clean(m->end.y()));
+        if (m->shape == Shape::Arc)
+            s += fmt::format(" c{:g},{:g} {} {:g}deg", clean(m->centre.x()), clean(m->centre.y()),
+                             m->ccw ? "ccw" : "cw", clean(m->sweep_rad * 180 / M_PI));
+        if (m->start_h != m->end_h || m->start_h != 0)
+            s += fmt::format(" h{:g}->{:g}", clean(m->start_h), clean(m->end_h));
+        return s + fmt::format(" {} #{}", role_name(m->role), m->tag);
+    }
+    if (const auto* k = std::get_if<OutMarker>(&o)) return fmt::format("marker #{}", k->tag);
+    return "warning #" + std::to_string(std::get<OutWarning>(o).tag);
+}
+
+Move line(double x, double y, Side side, double r, SourceTag tag, bool rapid = false) {
+    Move m;
+    m.end = {x, y};
+    m.side = side;
+    m.radius_mm = r;
+    m.tag = tag;
+    m.rapid = rapid;
+    return m;
+}
+
+Move arc(double x, double y, double cx, double cy, bool ccw, Side side, double r, SourceTag tag) {
+    Move m = line(x, y, side, r, tag);
+    m.shape = Shape::Arc;
+    m.centre = {cx, cy};
+    m.ccw = ccw;
+    return m;
+}
+
+Move at_h(Move m, double h) {
+    m.end_h = h;
+    return m;
+}
+
+Move height(double h, Side side, double r, SourceTag tag, Vec2 at) {
+    Move m = line(at.x(), at.y(), side, r, tag);
+    m.end_h = h;
+    return m;
+}
+
+Lines run(Compensator& c, const std::vector<Move>& moves, bool finish = true) {
+    for (const auto& m : moves) c.push(m);
+    if (finish) c.finish();
+    Lines out;
+    for (const auto& o : c.drain()) out.push_back(describe(o));
+    return out;
+}
+
+// Starts at (5, 5) so that a first move to (0, 0) moves in the plane.
+CompError error_of(const std::vector<Move>& moves, Config cfg = {}, Vec2 start = {5, 5}) {
+    Compensator c(cfg, start);
+    try {
+        run(c, moves);
+    } catch (const CompError& e) {
+        return e;
+    }
+    return CompError("no error", 0, 0);
+}
+
+constexpr Side L = Side::Left;
+constexpr Side R = Side::Right;
+constexpr Side Off = Side::Off;
+
+TEST(CutterComp, ManualProgram2RunsWithPerpendicularStartAndCancel) {
+    // G92 X0 Y0 / G0 G41 X10 Y10 D01 / G1 X20 Y10 / G0 G40 X0 Y0, with r = 2:
+    // start-up ends on the perpendicular of block 3 at its start (10, 12); the
+    // contour runs at y = 12; the cancel leaves from (20, 12) to (0, 0).
+    Compensator c;
+    EXPECT_EQ(
+        run(c, {line(10, 10, L, 2, 2, true), line(20, 10, L, 2, 3), line(0, 0, Off, 2, 4, true)}),
+        (Lines{"L 0,0 -> 10,12 startup #2", "L 10,12 -> 20,12 contour #3",
+               "L 20,12 -> 0,0 cancel #4"}));
+}
+
+TEST(CutterComp, ManualProgram1IsAPathReversal) {
+    const CompError e =
+        error_of({line(10, 10, L, 2, 2, true), line(20, 10, L, 2, 3), line(0, 10, Off, 2, 4, true)},
+                 Config{}, {0, 0});
+    EXPECT_STREQ(e.what(), "cutter comp: path reversal between line 3 and line 4");
+    EXPECT_EQ(e.first_block, 3);
+    EXPECT_EQ(e.second_block, 4);
+}
+
+TEST(CutterComp, ReversalInsideTheContourToo) {
+    // S1: "G1 X5 Y10" after "G1 X20 Y10" is an error.
+    const CompError e =
+        error_of({line(10, 10, L, 2, 2), line(20, 10, L, 2, 3), line(5, 10, L, 2, 4)});
+    EXPECT_STREQ(e.what(), "cutter comp: path reversal between line 3 and line 4");
+}
+
+TEST(CutterComp, OutsideCornersGetArcsAroundTheCornerPoint) {
+    // A CCW 10×10 square with G42 (tool right of travel = outside), r = 1.
+    Compensator c(Config{}, {-5, -5});
+    EXPECT_EQ(run(c, {line(0, 0, R, 1, 1), line(10, 0, R, 1, 2), line(10, 10, R, 1, 3),
+                      line(0, 10, R, 1, 4), line(0, 0, R, 1, 5), line(-5, -5, Off, 1, 6)}),
+              (Lines{"L -5,-5 -> 0,-1 startup #1", "L 0,-1 -> 10,-1 contour #2",
+                     "A 10,-1 -> 11,0 c10,0 ccw 90deg corner #3", "L 11,0 -> 11,10 contour #3",
+                     "A 11,10 -> 10,11 c10,10 ccw 90deg corner #4", "L 10,11 -> 0,11 contour #4",
+                     "A 0,11 -> -1,10 c0,10 ccw 90deg corner #5", "L -1,10 -> -1,0 contour #5",
+                     "L -1,0 -> -5,-5 cancel #6"}));
+}
+
+TEST(CutterComp, ExtendedLineCornersWhenConfigured) {
+    Config cfg;
+    cfg.extend_max_turn_deg = 90;
+    Compensator c(cfg, {-5, -5});
+    const Lines out = run(c, {line(0, 0, R, 1, 1), line(10, 0, R, 1, 2), line(10, 10, R, 1, 3),
+                              line(-5, 10, Off, 1, 4)});
+    EXPECT_EQ(out, (Lines{"L -5,-5 -> 0,-1 startup #1", "L 0,-1 -> 10,-1 contour #2",
+                          "L 10,-1 -> 11,-1 corner #3", "L 11,-1 -> 11,0 corner #3",
+                          "L 11,0 -> 11,10 contour #3", "L 11,10 -> -5,10 cancel #4"}));
+}
+
+TEST(CutterComp, InsideCornersAreTrimmedToTheIntersection) {
+    // The same square with G41 (tool inside), from the centre.
+    Compensator c(Config{}, {5, 5});
+    EXPECT_EQ(
+        run(c, {line(0, 0, L, 1, 1), line(10, 0, L, 1, 2), line(10, 10, L, 1, 3),
+                line(0, 10, L, 1, 4), line(0, 0, L, 1, 5), line(5, 5, Off, 1, 6)}),
+        (Lines{"L 5,5 -> 0,1 startup #1", "L 0,1 -> 9,1 contour #2", "L 9,1 -> 9,9 contour #3",
+               "L 9,9 -> 1,9 contour #4", "L 1,9 -> 1,0 contour #5", "L 1,0 -> 5,5 cancel #6"}));
+}
+
+TEST(CutterComp, FullCircleInsideShrinksTheRadius) {
+    // G41 G1 X10 / G3 X10 Y0 I-10 (full CCW circle, tool inside) / G40 G1 X0, r 2.
+    Compensator c;
+    EXPECT_EQ(
+        run(c, {line(10, 0, L, 2, 1), arc(10, 0, 0, 0, true, L, 2, 2), line(0, 0, Off, 2, 3)}),
+        (Lines{"L 0,0 -> 8,0 startup #1", "A 8,0 -> 8,0 c0,0 ccw 360deg contour #2",
+               "L 8,0 -> 0,0 cancel #3"}));
+}
+
+TEST(CutterComp, LineToArcInsideCornerMeetsTheShrunkCircle) {
+    // Left comp r 1: line (0,0)→(10,0), then a CCW arc of radius 10 about (10,10)
+    // starting straight down... i.e. from (10,0) heading +X: tangent, no corner.
+    // Make a corner instead: line (0,-10)→(10,0) (heading 45°), then the same arc
+    // (heading +X at its start) turns right by 45°: outside for G41 → corner arc.
+    Compensator c(Config{}, {-10, -10});
+    const Lines out = run(c, {line(0, -10, L, 1, 1), line(10, 0, L, 1, 2),
+                              arc(20, 10, 10, 10, true, L, 1, 3), line(20, 20, Off, 1, 4)});
+    ASSERT_EQ(out.size(), 5u);
+    EXPECT_EQ(out[2], fmt::format("A {:g},{:g} -> 10,1 c10,0 cw 45deg corner #3",
+                                  clean(10 - std::sqrt(0.5)), clean(std::sqrt(0.5))));
+    EXPECT_EQ(out[3], "A 10,1 -> 19,10 c10,10 ccw 90deg contour #3");
+}
+
+TEST(CutterComp, HelixOffsetInPlaneHeightFollows) {
+    Compensator c;
+    Move h = arc(10, 0, 0, 0, true, L, 2, 2);
+    h.end_h = -3;
+    const Lines out = run(c, {line(10, 0, L, 2, 1), h, line(0, 0, Off, 2, 3)});
+    EXPECT_EQ(out[1], "A 8,0 -> 8,0 c0,0 ccw 360deg h0->-3 contour #2");
+}
+
+TEST(CutterComp, ZMovesAndMarkersWaitAtTheCorner) {
+    // A Z plunge and an M code between the first two contour moves come out
+    // after the corner, at the offset start of the next move.
+    Compensator c(Config{}, {-5, -5});
+    c.push(line(0, 0, R, 1, 1));
+    c.push(line(10, 0, R, 1, 2));
+    c.push(height(-2, R, 1, 3, {10, 0}));
+    c.push(Marker{4});
+    c.push(at_h(line(10, 10, R, 1, 5), -2));
+    c.push(at_h(line(20, 10, Off, 1, 6), -2));
+    c.finish();
+    Lines out;
+    for (const auto& o : c.drain()) out.push_back(describe(o));
+    EXPECT_EQ(out,
+              (Lines{"L -5,-5 -> 0,-1 startup #1", "L 0,-1 -> 10,-1 contour #2",
+                     "A 10,-1 -> 11,0 c10,0 ccw 90deg corner #5", "L 11,0 -> 11,0 h0->-2 height #3",
+                     "marker #4", "L 11,0 -> 11,10 h-2->-2 contour #5",
+                     "L 11,10 -> 20,10 h-2->-2 cancel #6"}));
+}
+
+TEST(CutterComp, TooManyMovesWithoutPlaneMotion) {
+    Config cfg;
+    cfg.lookahead_moves = 2;
+    std::vector<Move> moves{line(0, 0, L, 1, 1), line(10, 0, L, 1, 2)};
+    for (int i = 0; i < 3; ++i) moves.push_back(height(-i - 1.0, L, 1, 3 + i, {10, 0}));
+    moves.push_back(at_h(line(10, 10, L, 1, 6), -3));
+    const CompError e = error_of(moves, cfg);
+    EXPECT_STREQ(e.what(),
+                 "cutter comp: more than 2 blocks without motion in the compensation plane between "
+                 "line 2 and line 5");
+    // With the perpendicular fallback the path ends on the perpendicular and restarts.
+    cfg.on_exhausted = OnLookaheadExhausted::Perpendicular;
+    // The restart goes to the perpendicular of line 6 at its start, (9, 0).
+    Compensator c(cfg, {0, -5});
+    const Lines out = run(c, moves);
+    EXPECT_EQ(out[1], "L 0,1 -> 10,1 contour #2");
+    EXPECT_EQ(out[5], "L 10,1 -> 9,0 h-3->-3 startup #6");
+    EXPECT_EQ(out[6], "L 9,0 -> 9,10 h-3->-3 contour #6");
+}
+
+TEST(CutterComp, SideSwitchLinksToTheNewSide) {
+    Compensator c(Config{}, {-5, 0});
+    const Lines out = run(c, {line(0, 0, L, 1, 1), line(10, 0, L, 1, 2), line(20, 0, R, 1, 3),
+                              line(30, 0, Off, 1, 4)});
+    EXPECT_EQ(out, (Lines{"L -5,0 -> 0,1 startup #1", "L 0,1 -> 10,1 contour #2",
+                          "L 10,1 -> 10,-1 startup #3", "L 10,-1 -> 20,-1 contour #3",
+                          "L 20,-1 -> 30,0 cancel #4"}));
+}
+
+TEST(CutterComp, CancelInABlockWithoutPlaneMotionReturnsToTheProgrammedPoint) {
+    Compensator c;
+    const Lines out =
+        run(c, {line(0, 0, L, 1, 1), line(10, 0, L, 1, 2), height(5, Off, 1, 3, {10, 0})});
+    EXPECT_EQ(out.back(), "L 10,1 -> 10,0 h0->5 cancel #3");
+    EXPECT_FALSE(c.active());
+}
+
+TEST(CutterComp, ProgramEndWithCompensationActiveWarns) {
+    Compensator c(Config{}, {-5, 0});
+    const Lines out = run(c, {line(0, 0, L, 1, 1), line(10, 0, L, 1, 2)});
+    EXPECT_EQ(out, (Lines{"L -5,0 -> 0,1 startup #1", "L 0,1 -> 10,1 contour #2", "warning #2"}));
+}
+
+TEST(CutterComp, CompensationOffPassesMovesThrough) {
+    Compensator c;
+    const Lines out = run(c, {line(5, 0, Off, 0, 1), arc(5, 10, 5, 5, true, Off, 0, 2)});
+    EXPECT_EQ(out, (Lines{"L 0,0 -> 5,0 plain #1", "A 5,0 -> 5,10 c5,5 ccw 180deg plain #2"}));
+}
+
+// ---- errors -----------------------------------------------------------------
+
+TEST(CutterCompErrors, StartOnAnArc) {
+    const CompError e = error_of({line(10, 0, Off, 0, 1), arc(0, 10, 0, 0, true, L, 1, 2)});
+    EXPECT_STREQ(e.what(),
+                 "cutter comp: compensation cannot start on an arc (line 2, after line 1); start "
+                 "it with G00/G01");
+    EXPECT_EQ(e.first_block, 1);
+    EXPECT_EQ(e.second_block, 2);
+}
+
+TEST(CutterCompErrors, CancelOnAnArc) {
+    const CompError e =
+        error_of({line(10, 0, L, 1, 1), line(20, 0, L, 1, 2), arc(30, 0, 25, 0, true, Off, 1, 3)});
+    EXPECT_STREQ(e.what(),
+                 "cutter comp: compensation cannot be cancelled on an arc (line 3, after line 2); "
+                 "cancel it with G00/G01");
+}
+
+TEST(CutterCompErrors, ToolLargerThanInsideArc) {
+    // CCW arc of radius 3 with G41: the tool (r 4) is on the centre side.
+    const CompError e = error_of({line(3, 0, L, 4, 1), arc(0, 3, 0, 0, true, L, 4, 2)});
+    EXPECT_STREQ(e.what(),
+                 "cutter comp: the tool radius 4 does not fit the inside arc of radius 3 at line 2 "
+                 "(compensation from line 1)");
+    EXPECT_EQ(e.first_block, 1);
+    EXPECT_EQ(e.second_block, 2);
+}
+
+TEST(CutterCompErrors, GougeWhenTheToolDoesNotFitAnInsideCorner) {
+    // Inside a 10×10 square with r 6: the offsets of the right and top edges
+    // meet before the offset of the right edge starts.
+    const CompError e = error_of({line(0, 0, L, 6, 1), line(10, 0, L, 6, 2), line(10, 10, L, 6, 3),
+                                  line(0, 10, L, 6, 4), line(0, 0, L, 6, 5)});
+    EXPECT_STREQ(
+        e.what(),
+        "cutter comp: gouge: the tool radius 6 does not fit the inside corner between line "
+        "3 and line 4");
+}
+
+TEST(CutterCompErrors, PlaneChangeWhileActive) {
+    Move m = line(10, 10, L, 1, 3);
+    m.plane = 18;
+    const CompError e = error_of({line(0, 0, L, 1, 1), line(10, 0, L, 1, 2), m});
+    EXPECT_STREQ(e.what(),
+                 "cutter comp: the plane changed from G17 to G18 while compensation is active (set "
+                 "at line 1, changed at line 3)");
+}
+
+TEST(CutterCompErrors, PositionCannotBeSetWhileActive) {
+    Compensator c;
+    c.push(line(10, 0, L, 1, 1));
+    EXPECT_THROW(c.set_position({0, 0}, 0), CompError);
+}
+
+}  // namespace

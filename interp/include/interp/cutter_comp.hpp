@@ -1,0 +1,186 @@
+#pragma once
+// Cutter radius compensation (G40/G41/G42) as a streaming core.
+//
+// The executor feeds, in program order, every block of one compensation plane as
+// either a Move (a line or arc in the plane, or a line with no plane motion such
+// as a Z-only move) or a Marker (a block with no motion: M code, dwell, comment,
+// a canonical command that must keep its place in the stream). Coordinates are
+// plane coordinates (a, b) after the executor's transforms (rotation, mirroring,
+// scaling) and h along the plane normal:
+//     G17: a=X b=Y h=Z    G18: a=Z b=X h=Y    G19: a=Y b=Z h=X
+// so that "counter-clockwise" means G03 in every plane. Mirroring one plane axis
+// swaps G41/G42 before the Move reaches this core; the radius is never scaled.
+//
+// The compensator holds back the last contour move until it has seen the next
+// one (look-ahead), because the end of a compensated move depends on the corner
+// it makes with the next move. Moves and Markers with no plane motion between two
+// contour moves are held too (up to Config::lookahead_moves moves), and come out
+// at the tool position of the corner, so Z moves and M codes do not break the
+// compensation. Output entries carry the source tag of the block they belong to;
+// corner pieces carry the tag of the block they lead into.
+//
+// Geometry (s = +1 for G41/left, −1 for G42/right, r = tool radius):
+//   - a line is offset by s·r along its left normal; an arc keeps its centre and
+//     its radius becomes ρ − s·r (CCW) or ρ + s·r (CW); a helix is offset in the
+//     plane, its height follows the programmed move.
+//   - start-up (first compensated move, a line): from the uncompensated tool
+//     position to the point on the perpendicular of the next move at its start
+//     (S0 §3.5.3 "offset to the perpendicular at the block start"); cancel
+//     (a line with side Off): from the perpendicular at the end of the last move
+//     to the programmed end point.
+//   - corners: inside (the turn is toward the tool side) → the two offset curves
+//     are trimmed to their intersection; outside → an arc of radius r around the
+//     programmed corner point, or (Config::extend_max_turn_deg) the two offset
+//     tangents extended to their intersection for mild turns.
+//   - errors (CompError, naming both blocks involved): a 180° reversal, an inside
+//     corner whose offset curves do not meet within both moves (gouge), a tool
+//     radius ≥ an inside arc radius, a plane change while active, start-up or
+//     cancel on an arc, too many moves without plane motion.
+//
+// Not realtime: allocates, throws.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace interp::cutter {
+
+using Vec2 = Eigen::Vector2d;
+/// The executor's identifier of a block, normally its source line; opaque here.
+using SourceTag = std::int64_t;
+
+enum class Side { Off, Left, Right };  // G40, G41, G42
+
+class CompError : public std::runtime_error {
+  public:
+    CompError(const std::string& what, SourceTag first, SourceTag second)
+        : std::runtime_error(what), first_block(first), second_block(second) {}
+    SourceTag first_block;
+    SourceTag second_block;
+};
+
+enum class Shape { Line, Arc };
+
+/// One programmed motion block, in plane coordinates.
+struct Move {
+    Shape shape = Shape::Line;
+    Vec2 end{0, 0};
+    Vec2 centre{0, 0};  // arcs
+    bool ccw = false;   // arcs: G03 (after mirroring)
+    double end_h = 0.0;
+    bool rapid = false;
+    Side side = Side::Off;   // G40/G41/G42 in effect for this block
+    double radius_mm = 0.0;  // tool radius (from D), ≥ 0
+    int plane = 17;          // G17/G18/G19; must not change while compensation is active
+    SourceTag tag = 0;
+};
+
+/// A block with no motion that must keep its place in the output.
+struct Marker {
+    SourceTag tag = 0;
+};
+
+enum class Role {
+    Plain,    // compensation off: the programmed move
+    Startup,  // start-up move, or the link after a side/radius change
+    Contour,  // the offset of a programmed move
+    Corner,   // inserted around an outside corner
+    Cancel,   // the move that leaves compensation
+    Height,   // a move without plane motion (Z only), at the corner position
+};
+
+/// One output motion: a line or an arc (sweep_rad > 0; start == end only for a full circle).
+struct OutMove {
+    Shape shape = Shape::Line;
+    Vec2 start{0, 0};
+    Vec2 end{0, 0};
+    Vec2 centre{0, 0};
+    bool ccw = false;
+    double sweep_rad = 0.0;
+    double start_h = 0.0;
+    double end_h = 0.0;
+    bool rapid = false;
+    Role role = Role::Plain;
+    SourceTag tag = 0;
+};
+struct OutMarker {
+    SourceTag tag = 0;
+};
+struct OutWarning {
+    std::string text;
+    SourceTag tag = 0;
+};
+using Output = std::variant<OutMove, OutMarker, OutWarning>;
+
+enum class OnLookaheadExhausted {
+    Error,          // raise a CompError naming both blocks
+    Perpendicular,  // end the held move on its perpendicular and restart like a start-up
+};
+
+struct Config {
+    /// Moves without plane motion allowed between two contour moves.
+    std::size_t lookahead_moves = 5;
+    OnLookaheadExhausted on_exhausted = OnLookaheadExhausted::Error;
+    /// Outside corners that turn by at most this angle use extended lines; 0 = always an arc.
+    double extend_max_turn_deg = 0.0;
+};
+
+class Compensator {
+  public:
+    explicit Compensator(Config config = {}, Vec2 start = Vec2::Zero(), double start_h = 0.0);
+    ~Compensator();
+    Compensator(Compensator&&) noexcept;
+    Compensator& operator=(Compensator&&) noexcept;
+
+    /// Tells the compensator where the tool is (after G92, G28, a program start).
+    /// Only while compensation is off and nothing is held.
+    void set_position(const Vec2& position, double h);
+
+    void push(const Move& move);
+    void push(const Marker& marker);
+
+    /// End of program (or of the compensated section, e.g. before G28): flushes
+    /// everything held; compensation still on is dropped with a warning.
+    void finish();
+
+    /// Takes the entries that are final.
+    std::vector<Output> drain();
+
+    /// True while a compensated move is held (compensation on).
+    bool active() const { return pending_ != nullptr; }
+
+  private:
+    struct Pending;  // the held contour move, defined in compensator.cpp
+    using Held = std::variant<Move, Marker>;
+
+    void push_no_plane_motion(const Move& move);
+    void push_plain(const Move& move);
+    void start_up(const Move& move);
+    void finish_start_up(const Move& move);
+    void join(const Move& move);
+    void link(const Move& move);
+    void cancel(const Move& move);
+    void end_pending_perpendicular();
+    void flush_held();
+    void emit_line(const Vec2& to, double to_h, bool rapid, Role role, SourceTag tag);
+    void emit_piece(OutMove piece, bool rapid, Role role, SourceTag tag);
+
+    Config config_;
+    Vec2 programmed_;  // uncompensated end of the last block
+    double programmed_h_;
+    Vec2 tool_;  // end of the last emitted output
+    double tool_h_;
+    std::optional<SourceTag> last_tag_;
+    std::unique_ptr<Pending> pending_;
+    std::deque<Held> held_;
+    std::size_t held_moves_ = 0;
+    std::vector<Output> out_;
+};
+
+}  // namespace interp::cutter

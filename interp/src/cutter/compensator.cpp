@@ -1,0 +1,362 @@
+// The streaming compensator: a one-move look-ahead state machine.
+//
+//   off ──(line with G41/G42)──▶ start-up ──(next move)──▶ contour ─┐
+//    ▲                              │                       ▲  │ join │
+//    │                              ▼                       └──┴──────┘
+//    └──────(line with G40)──── cancel ◀──── resume ◀─ side/radius change,
+//                                                      look-ahead exhausted
+//
+// "pending" is the last compensated move whose end is not yet known; its end
+// is fixed by the corner it makes with the next move (join), by the cancel
+// (perpendicular end), or by running out of look-ahead.
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "offset_geometry.hpp"
+
+namespace interp::cutter {
+
+using geom::Curve;
+using geom::Segment;
+
+namespace {
+
+constexpr double kSamePointMm = 1e-9;
+constexpr double kParallel = 1e-9;  // |sin| of a turn treated as straight or reversed
+
+double side_sign(Side side) {
+    return side == Side::Left ? 1.0 : -1.0;
+}
+
+bool full_circle(const Curve& c) {
+    return c.shape == Shape::Arc && c.sweep >= 2.0 * std::numbers::pi - 1e-12;
+}
+
+}  // namespace
+
+struct Compensator::Pending {
+    enum class Kind { StartUp, Contour, Resume };
+    Kind kind = Kind::StartUp;
+    Segment seg;       // the programmed move (StartUp: the start-up line)
+    Curve curve;       // Contour: its offset
+    double u_start;    // Contour: where the offset starts after the previous corner
+    Move move;         // the block itself (side, radius, plane, tag, rapid)
+    SourceTag on_tag;  // the block that switched compensation (or its side) on
+};
+
+Compensator::Compensator(Config config, Vec2 start, double start_h)
+    : config_(config), programmed_(start), programmed_h_(start_h), tool_(start), tool_h_(start_h) {}
+Compensator::~Compensator() = default;
+Compensator::Compensator(Compensator&&) noexcept = default;
+Compensator& Compensator::operator=(Compensator&&) noexcept = default;
+
+void Compensator::set_position(const Vec2& position, double h) {
+    if (pending_ || !held_.empty()) {
+        const SourceTag t = last_tag_.value_or(0);
+        throw CompError(
+            "cutter comp: the position cannot be redefined while compensation is active", t, t);
+    }
+    programmed_ = tool_ = position;
+    programmed_h_ = tool_h_ = h;
+}
+
+std::vector<Output> Compensator::drain() {
+    std::vector<Output> out;
+    out.swap(out_);
+    return out;
+}
+
+void Compensator::push(const Marker& marker) {
+    if (pending_)
+        held_.emplace_back(marker);
+    else
+        out_.emplace_back(OutMarker{marker.tag});
+}
+
+void Compensator::push(const Move& move) {
+    const Segment seg = Segment::make(programmed_, programmed_h_, move);
+    if (pending_ && move.plane != pending_->move.plane)
+        throw CompError(fmt::format("cutter comp: the plane changed from G{} to G{} while "
+                                    "compensation is active (set at line {}, changed at line {})",
+                                    pending_->move.plane, move.plane, pending_->on_tag, move.tag),
+                        pending_->on_tag, move.tag);
+    if (seg.degenerate()) {
+        push_no_plane_motion(move);
+    } else if (!pending_) {
+        if (move.side == Side::Off)
+            push_plain(move);
+        else
+            start_up(move);
+    } else if (move.side == Side::Off) {
+        cancel(move);
+    } else if (pending_->kind == Pending::Kind::Resume || move.side != pending_->move.side ||
+               move.radius_mm != pending_->move.radius_mm) {
+        end_pending_perpendicular();
+        link(move);
+    } else if (pending_->kind == Pending::Kind::StartUp) {
+        finish_start_up(move);
+    } else {
+        join(move);
+    }
+    programmed_ = move.end;
+    programmed_h_ = move.end_h;
+    last_tag_ = move.tag;
+}
+
+void Compensator::finish() {
+    if (pending_) {
+        const SourceTag tag = pending_->move.tag;
+        end_pending_perpendicular();
+        pending_.reset();
+        out_.emplace_back(OutWarning{
+            "cutter comp: compensation still active at program end; cancelled without a move",
+            tag});
+    }
+    flush_held();
+}
+
+void Compensator::push_plain(const Move& move) {
+    const Segment seg = Segment::make(programmed_, programmed_h_, move);
+    OutMove m;
+    m.shape = move.shape;
+    m.start = tool_;
+    m.end = move.end;
+    m.start_h = tool_h_;
+    m.end_h = move.end_h;
+    if (move.shape == Shape::Arc) {
+        m.centre = move.centre;
+        m.ccw = move.ccw;
+        m.sweep_rad = seg.sweep;
+    }
+    m.rapid = move.rapid;
+    m.role = Role::Plain;
+    m.tag = move.tag;
+    out_.emplace_back(m);
+    tool_ = move.end;
+    tool_h_ = move.end_h;
+}
+
+void Compensator::push_no_plane_motion(const Move& move) {
+    if (!pending_) {
+        emit_line(tool_, move.end_h, move.rapid, Role::Plain, move.tag);
+        return;
+    }
+    if (move.side == Side::Off) {
+        // G40 in a block without plane motion cancels in that block: the tool
+        // returns from the perpendicular to the programmed point.
+        end_pending_perpendicular();
+        pending_.reset();
+        emit_line(programmed_, move.end_h, move.rapid, Role::Cancel, move.tag);
+        return;
+    }
+    held_.emplace_back(move);
+    if (++held_moves_ <= config_.lookahead_moves) return;
+    if (config_.on_exhausted == OnLookaheadExhausted::Error)
+        throw CompError(fmt::format("cutter comp: more than {} blocks without motion in the "
+                                    "compensation plane between line {} and line {}",
+                                    config_.lookahead_moves, pending_->move.tag, move.tag),
+                        pending_->move.tag, move.tag);
+    end_pending_perpendicular();
+}
+
+namespace {
+
+Curve offset_or_throw(const Segment& seg, const Move& move, SourceTag on_tag) {
+    const auto curve = geom::offset(seg, side_sign(move.side) * move.radius_mm);
+    if (!curve)
+        throw CompError(fmt::format("cutter comp: the tool radius {:g} does not fit the inside arc "
+                                    "of radius {:g} at line {} (compensation from line {})",
+                                    move.radius_mm, seg.radius, move.tag, on_tag),
+                        on_tag, move.tag);
+    return *curve;
+}
+
+void check_reversal(const Vec2& t_in, const Vec2& t_out, SourceTag a, SourceTag b) {
+    if (std::abs(geom::cross(t_in, t_out)) <= kParallel && t_in.dot(t_out) < 0)
+        throw CompError(fmt::format("cutter comp: path reversal between line {} and line {}", a, b),
+                        a, b);
+}
+
+}  // namespace
+
+void Compensator::start_up(const Move& move) {
+    if (move.shape == Shape::Arc) {
+        const SourceTag before = last_tag_.value_or(move.tag);
+        throw CompError(fmt::format("cutter comp: compensation cannot start on an arc (line {}, "
+                                    "after line {}); start it with G00/G01",
+                                    move.tag, before),
+                        before, move.tag);
+    }
+    pending_ = std::make_unique<Pending>();
+    pending_->kind = Pending::Kind::StartUp;
+    pending_->seg = Segment::make(programmed_, programmed_h_, move);
+    pending_->move = move;
+    pending_->on_tag = move.tag;
+}
+
+void Compensator::finish_start_up(const Move& move) {
+    const Segment seg = Segment::make(programmed_, programmed_h_, move);
+    const Curve curve = offset_or_throw(seg, move, pending_->on_tag);
+    // S0 §3.5.3: the start-up block ends on the perpendicular at the next block's start.
+    emit_line(curve.at(0), pending_->seg.h1, pending_->move.rapid, Role::Startup,
+              pending_->move.tag);
+    flush_held();
+    const SourceTag on_tag = pending_->on_tag;
+    *pending_ = Pending{Pending::Kind::Contour, seg, curve, 0.0, move, on_tag};
+}
+
+void Compensator::link(const Move& move) {
+    const Segment seg = Segment::make(programmed_, programmed_h_, move);
+    const SourceTag on_tag = move.side != pending_->move.side ? move.tag : pending_->on_tag;
+    const Curve curve = offset_or_throw(seg, move, on_tag);
+    emit_line(curve.at(0), seg.h0, move.rapid, Role::Startup, move.tag);
+    *pending_ = Pending{Pending::Kind::Contour, seg, curve, 0.0, move, on_tag};
+}
+
+void Compensator::join(const Move& move) {
+    Pending& a = *pending_;
+    const Segment seg = Segment::make(programmed_, programmed_h_, move);
+    const Curve next = offset_or_throw(seg, move, a.on_tag);
+    const Vec2 t_in = a.seg.tangent(1.0);
+    const Vec2 t_out = seg.tangent(0.0);
+    const double turn_sin = geom::cross(t_in, t_out);
+    check_reversal(t_in, t_out, a.move.tag, move.tag);
+
+    const double r = move.radius_mm;
+    const double s = side_sign(move.side);
+    double u_next = 0.0;
+    if (r == 0.0 || std::abs(turn_sin) <= kParallel) {
+        emit_piece(a.curve.piece(a.u_start, 1.0), a.move.rapid, Role::Contour, a.move.tag);
+    } else if (s * turn_sin > 0) {
+        // Inside corner: trim both offsets to their intersection nearest the
+        // corner, which must lie within what is left of each move.
+        const Vec2 corner = seg.start;
+        std::optional<std::pair<double, double>> best;
+        double best_dist = 0.0;
+        for (const Vec2& p : geom::intersections(a.curve, next)) {
+            double ua = a.curve.param(p);
+            if (full_circle(a.curve) && ua <= a.curve.tol_u()) ua = 1.0;
+            const double ub = next.param(p);
+            const bool inside_a = ua >= a.u_start - a.curve.tol_u() && ua <= 1.0 + a.curve.tol_u();
+            const bool inside_b = ub >= -next.tol_u() && ub <= 1.0 + next.tol_u();
+            const double dist = (p - corner).norm();
+            if (inside_a && inside_b && (!best || dist < best_dist)) {
+                best = std::make_pair(std::clamp(ua, a.u_start, 1.0), std::clamp(ub, 0.0, 1.0));
+                best_dist = dist;
+            }
+        }
+        if (!best)
+            throw CompError(
+                fmt::format("cutter comp: gouge: the tool radius {:g} does not fit the inside "
+                            "corner between line {} and line {}",
+                            r, a.move.tag, move.tag),
+                a.move.tag, move.tag);
+        emit_piece(a.curve.piece(a.u_start, best->first), a.move.rapid, Role::Contour, a.move.tag);
+        u_next = best->second;
+    } else {
+        // Outside corner: go around the corner point at distance r.
+        emit_piece(a.curve.piece(a.u_start, 1.0), a.move.rapid, Role::Contour, a.move.tag);
+        const Vec2 from = tool_;
+        const Vec2 to = next.at(0.0);
+        const double turn = std::atan2(std::abs(turn_sin), t_in.dot(t_out));
+        const double extend_max = config_.extend_max_turn_deg * std::numbers::pi / 180.0;
+        const auto knee = geom::line_line(from, t_in, to, t_out);
+        if (turn <= extend_max && knee) {
+            emit_line(*knee, tool_h_, move.rapid, Role::Corner, move.tag);
+            emit_line(to, tool_h_, move.rapid, Role::Corner, move.tag);
+        } else {
+            OutMove arc;
+            arc.shape = Shape::Arc;
+            arc.start = from;
+            arc.end = to;
+            arc.centre = seg.start;
+            arc.ccw = turn_sin > 0;
+            arc.sweep_rad = turn;
+            arc.start_h = arc.end_h = tool_h_;
+            emit_piece(arc, move.rapid, Role::Corner, move.tag);
+        }
+    }
+    flush_held();
+    const SourceTag on_tag = a.on_tag;
+    *pending_ = Pending{Pending::Kind::Contour, seg, next, u_next, move, on_tag};
+}
+
+void Compensator::cancel(const Move& move) {
+    if (move.shape == Shape::Arc)
+        throw CompError(fmt::format("cutter comp: compensation cannot be cancelled on an arc "
+                                    "(line {}, after line {}); cancel it with G00/G01",
+                                    move.tag, pending_->move.tag),
+                        pending_->move.tag, move.tag);
+    if (pending_->kind != Pending::Kind::Resume) {
+        const Segment seg = Segment::make(programmed_, programmed_h_, move);
+        check_reversal(pending_->seg.tangent(1.0), seg.tangent(0.0), pending_->move.tag, move.tag);
+    }
+    end_pending_perpendicular();
+    pending_.reset();
+    emit_line(move.end, move.end_h, move.rapid, Role::Cancel, move.tag);
+}
+
+void Compensator::end_pending_perpendicular() {
+    Pending& p = *pending_;
+    switch (p.kind) {
+        case Pending::Kind::StartUp: {
+            const Vec2 t = p.seg.tangent(1.0);
+            const Vec2 left(-t.y(), t.x());
+            emit_line(p.seg.end + left * (side_sign(p.move.side) * p.move.radius_mm), p.seg.h1,
+                      p.move.rapid, Role::Startup, p.move.tag);
+            break;
+        }
+        case Pending::Kind::Contour:
+            emit_piece(p.curve.piece(p.u_start, 1.0), p.move.rapid, Role::Contour, p.move.tag);
+            break;
+        case Pending::Kind::Resume:
+            break;
+    }
+    flush_held();
+    p.kind = Pending::Kind::Resume;
+}
+
+void Compensator::flush_held() {
+    for (const Held& h : held_) {
+        if (const auto* m = std::get_if<Move>(&h))
+            emit_line(tool_, m->end_h, m->rapid, Role::Height, m->tag);
+        else
+            out_.emplace_back(OutMarker{std::get<Marker>(h).tag});
+    }
+    held_.clear();
+    held_moves_ = 0;
+}
+
+void Compensator::emit_line(const Vec2& to, double to_h, bool rapid, Role role, SourceTag tag) {
+    if ((to - tool_).norm() <= kSamePointMm && std::abs(to_h - tool_h_) <= kSamePointMm) return;
+    OutMove m;
+    m.start = tool_;
+    m.end = to;
+    m.start_h = tool_h_;
+    m.end_h = to_h;
+    m.rapid = rapid;
+    m.role = role;
+    m.tag = tag;
+    out_.emplace_back(m);
+    tool_ = to;
+    tool_h_ = to_h;
+}
+
+void Compensator::emit_piece(OutMove piece, bool rapid, Role role, SourceTag tag) {
+    const double length = piece.shape == Shape::Arc
+                              ? (piece.start - piece.centre).norm() * piece.sweep_rad
+                              : (piece.end - piece.start).norm();
+    if (length <= kSamePointMm && std::abs(piece.end_h - piece.start_h) <= kSamePointMm) return;
+    if (piece.shape == Shape::Line) piece.start = tool_;
+    piece.rapid = rapid;
+    piece.role = role;
+    piece.tag = tag;
+    out_.emplace_back(piece);
+    tool_ = piece.end;
+    tool_h_ = piece.end_h;
+}
+
+}  // namespace interp::cutter
