@@ -168,14 +168,6 @@ void check_contour(const Contour& c, Side side, double r, std::uint32_t seed) {
     for (std::size_t i = 0; i < m; ++i) push(c.pieces[i], side, static_cast<SourceTag>(i + 2));
     push(make_line(c.pieces[0].a, start), Side::Off, static_cast<SourceTag>(m + 2));
     comp.finish();
-    if (std::getenv("CC_DEBUG"))
-        for (std::size_t i = 0; i < m; ++i)
-            std::printf(
-                "tag %zu arc %d a %.6f %.6f b %.6f %.6f c %.6f %.6f ccw %d rho %.6f sweep %.6f\n",
-                i + 2, c.pieces[i].arc, c.pieces[i].a.x(), c.pieces[i].a.y(), c.pieces[i].b.x(),
-                c.pieces[i].b.y(), c.pieces[i].c.x(), c.pieces[i].c.y(), c.pieces[i].ccw,
-                c.pieces[i].rho, c.pieces[i].sweep);
-
     std::vector<bool> covered(m, false);
     Vec2 at = start;
     for (const Output& o : comp.drain()) {
@@ -187,12 +179,14 @@ void check_contour(const Contour& c, Side side, double r, std::uint32_t seed) {
         if (mv->role == Role::Startup || mv->role == Role::Cancel) continue;
         for (int k = 0; k <= 40; ++k) {
             const Vec2 p = sample(*mv, k / 40.0);
-            for (std::size_t j = 0; j < m; ++j)
+            for (std::size_t j = 0; j < m; ++j) {
                 ASSERT_GE(distance(p, c.pieces[j]), r - 1e-6)
                     << "seed " << seed << " tag " << mv->tag << " near segment " << j + 2;
-            if (mv->role == Role::Contour)
+            }
+            if (mv->role == Role::Contour) {
                 ASSERT_NEAR(distance(p, c.pieces[mv->tag - 2]), r, 1e-6)
                     << "seed " << seed << " tag " << mv->tag;
+            }
         }
         if (mv->role == Role::Contour) covered[mv->tag - 2] = true;
     }
