@@ -1,0 +1,363 @@
+#include "interp/interpreter.hpp"
+
+#include <array>
+#include <string>
+
+#include "interp/text.hpp"
+
+namespace interp {
+
+namespace {
+
+constexpr int kCustomGFlag = 1000;  // CallFrame::custom_code of G n is 1000 + n
+
+// Fixed-cycle variables a custom G code receives (FC-1): X Y Z R Q P F, K or L.
+struct FcWord {
+    char letter;
+    int fc;
+};
+constexpr FcWord kFcWords[] = {{'X', 1}, {'Y', 2}, {'Z', 3}, {'R', 4}, {'Q', 5},
+                               {'P', 6}, {'F', 7}, {'K', 11}, {'L', 11}};
+
+// A queued public.dat call produced by a custom code in the block.
+struct CustomCall {
+    int code;  // M n -> n, G n -> 1000 + n
+    std::int64_t program;
+    LabelSite site;
+    int col;
+};
+
+bool starts_with_slash(std::string_view line) {
+    for (char c : line) {
+        if (is_space(c)) continue;
+        return c == '/';
+    }
+    return false;
+}
+
+// Sequence number at the start of a line ("  N0120 G1 …" -> 120), if any.
+std::optional<std::int64_t> leading_sequence(std::string_view line) {
+    std::size_t i = 0;
+    while (i < line.size() && (is_space(line[i]) || line[i] == '/')) ++i;
+    if (i >= line.size() || to_upper(line[i]) != 'N') return std::nullopt;
+    ++i;
+    while (i < line.size() && is_space(line[i])) ++i;
+    if (i >= line.size() || !is_digit(line[i])) return std::nullopt;
+    std::int64_t n = 0;
+    while (i < line.size() && is_digit(line[i]) && n < (std::int64_t{1} << 50)) {
+        n = n * 10 + (line[i] - '0');
+        ++i;
+    }
+    return n;
+}
+
+bool is_label_line(std::string_view line) {
+    std::size_t i = 0;
+    while (i < line.size() && is_space(line[i])) ++i;
+    if (i + 1 >= line.size() || to_upper(line[i]) != 'O') return false;
+    return is_digit(line[i + 1]) || quote_length(line.substr(i + 1)) != 0;
+}
+
+// Searches `src` from `from` for a line starting with N `seq`, stopping at the next subprogram
+// label (the end of the current program) or at `stop` when given.
+std::optional<SourcePos> find_sequence(Source& src, SourcePos from, std::int64_t seq,
+                                       std::optional<std::uint64_t> stop) {
+    src.seek(from);
+    std::string_view line;
+    bool first = true;
+    while (src.next_line(line)) {
+        const SourcePos at = src.line_start();
+        if (stop && at.offset >= *stop) return std::nullopt;
+        if (is_label_line(line) && !first) return std::nullopt;
+        first = false;
+        if (leading_sequence(line) == seq) return at;
+    }
+    return std::nullopt;
+}
+
+}  // namespace
+
+Interpreter::Interpreter(BlockExecutor& executor, MachineQuery& machine, InterpreterOptions options)
+    : executor_(executor),
+      machine_(machine),
+      options_(options),
+      parser_(*options.dialect, vars_, machine) {}
+
+Interpreter::~Interpreter() = default;
+
+void Interpreter::load_library(const std::string& path) { library_ = Source::open_file(path); }
+
+void Interpreter::set_library(std::unique_ptr<Source> library) { library_ = std::move(library); }
+
+void Interpreter::open(const std::string& path) { open(Source::open_file(path)); }
+
+void Interpreter::open(std::unique_ptr<Source> program) {
+    main_ = std::move(program);
+    current_ = main_.get();
+    stack_.clear();
+    vars_.clear();
+    finished_ = false;
+    main_started_ = false;
+}
+
+void Interpreter::run() {
+    while (step()) {
+    }
+}
+
+bool Interpreter::step() {
+    if (finished_) return false;
+    std::string_view line;
+    if (!current_->next_line(line)) {
+        const SourceLoc eof{current_->name(), current_->line_number() + 1, 1};
+        if (!stack_.empty()) {
+            const std::string label = stack_.back().label;
+            finished_ = true;
+            stack_.clear();
+            throw Error(eof, "subprogram " + label + " ends without M17");
+        }
+        end_program(eof);
+        return false;
+    }
+    const SourceLoc loc{current_->name(), current_->line_number(), 1};
+    if (options_.block_delete && starts_with_slash(line)) return true;
+    vars_.begin();
+    try {
+        parser_.parse(line, loc, parsed_);
+        execute_line(parsed_.block.loc);
+        vars_.commit();
+    } catch (...) {
+        vars_.rollback();
+        throw;
+    }
+    return !finished_;
+}
+
+void Interpreter::end_program(const SourceLoc& loc) {
+    finished_ = true;
+    stack_.clear();
+    executor_.end_of_input(loc);
+}
+
+void Interpreter::execute_line(const SourceLoc& loc) {
+    ParsedLine& line = parsed_;
+    if (line.is_label) {
+        if (stack_.empty()) {
+            // A label before any block names the main program; after blocks it is the first
+            // subprogram, which the main program must not run into (S0 §3.12 ex. 5).
+            if (main_started_) end_program(loc);
+            return;
+        }
+        const std::string label = stack_.back().label;
+        finished_ = true;
+        stack_.clear();
+        throw Error(loc, "subprogram " + label + " runs into the next label without M17");
+    }
+    if (stack_.empty()) main_started_ = true;
+
+    FlowWords flow = take_flow_words(line, *options_.dialect);
+    Block& b = line.block;
+
+    // Resolve everything that can fail before the block runs: a rejected block changes nothing.
+    std::optional<CallFrame> call_frame;
+    if (flow.call) {
+        const CallRequest& c = *flow.call;
+        const std::string label = program_label(c.program, c.name);
+        Source* found_in = nullptr;
+        std::optional<LabelSite> site;
+        for (Source* s : {current_, main_.get(), library_.get()}) {
+            if (s == nullptr) continue;
+            site = c.name ? s->find_label(*c.name) : s->find_label(c.program);
+            if (site) {
+                found_in = s;
+                break;
+            }
+        }
+        if (!site) throw Error(c.loc, "subprogram " + label + " not found");
+        if (c.count > 0) {
+            CallFrame f;
+            f.source = found_in;
+            f.body = SourcePos{site->pos.offset, site->pos.line};
+            f.remaining = c.count;
+            f.label = label;
+            call_frame = f;
+        }
+    }
+
+    StaticVec<CustomCall, Block::kMaxCodes> customs;
+    const Dialect& d = *options_.dialect;
+    auto active = [&](int code) {
+        for (const CallFrame& f : stack_)
+            if (f.custom_code == code) return true;
+        return false;
+    };
+    if (library_) {
+        for (std::size_t i = 0; i < b.m.size();) {
+            const int m = b.m[i];
+            std::optional<LabelSite> site;
+            if (m <= d.custom_code_max && !active(m)) site = library_->find_label(d.custom_m_base + m);
+            if (site) {
+                customs.push_back(CustomCall{m, d.custom_m_base + m, *site, b.m_col[i]});
+                b.m.erase_at(i);
+                b.m_col.erase_at(i);
+            } else {
+                ++i;
+            }
+        }
+        for (std::size_t i = 0; i < b.g.size();) {
+            const int g = b.g[i];
+            std::optional<LabelSite> site;
+            if (g % 10 == 0 && g / 10 <= d.custom_code_max && !active(kCustomGFlag + g / 10))
+                site = library_->find_label(d.custom_g_base + g / 10);
+            if (site) {
+                if (flow.call) {
+                    throw Error(SourceLoc{b.loc.file, b.loc.line, b.g_col[i]},
+                                "custom G" + std::to_string(g / 10) +
+                                    " and a subprogram call in one block");
+                }
+                customs.push_back(
+                    CustomCall{kCustomGFlag + g / 10, d.custom_g_base + g / 10, *site, b.g_col[i]});
+                b.g.erase_at(i);
+                b.g_col.erase_at(i);
+            } else {
+                ++i;
+            }
+        }
+    }
+    bool custom_g = false;
+    for (const CustomCall& cc : customs) custom_g = custom_g || cc.code >= kCustomGFlag;
+    // A custom G code takes the block's address words as its arguments (#FC…); the other G and M
+    // codes act first, as for ISO G macros (CUS-5, MACG-2).
+    std::array<std::optional<double>, 51> fc_args{};
+    if (custom_g) {
+        for (const FcWord& w : kFcWords) {
+            const int i = letter_index(w.letter);
+            if (b.words[i]) {
+                fc_args[w.fc] = b.words[i];
+                b.words[i].reset();
+                b.word_col[i] = 0;
+            }
+        }
+    }
+
+    const std::size_t new_frames = (call_frame ? 1 : 0) + customs.size();
+    if (stack_.size() + new_frames > static_cast<std::size_t>(d.max_call_depth)) {
+        throw Error(flow.call ? flow.call->loc : loc,
+                    "subprogram calls nested deeper than " + std::to_string(d.max_call_depth) +
+                        " levels");
+    }
+
+    if (!b.empty()) executor_.execute(b);
+    if (b.has_m(2) || b.has_m(30)) {
+        finished_ = true;
+        stack_.clear();
+        return;
+    }
+
+    if (custom_g) {
+        for (int fc = 1; fc <= 50; ++fc)
+            if (fc_args[fc]) vars_.set_fixed_cycle(fc, *fc_args[fc], loc);
+        vars_.set_fixed_cycle(12, machine_.cycle_return_to_r() ? 1.0 : 0.0, loc);
+        vars_.set_fixed_cycle(13, machine_.incremental_mode() ? 1.0 : 0.0, loc);
+        vars_.set_fixed_cycle(14, machine_.work_pos_mm(Axis::Z) / machine_.mm_per_program_unit(),
+                              loc);
+    }
+
+    const SourcePos after_call = current_->tell();
+    if (flow.ret) {
+        const ReturnRequest& r = *flow.ret;
+        if (stack_.empty()) {
+            if (r.m != 99) throw Error(r.loc, "M" + std::to_string(r.m) + " outside a subprogram");
+            if (!options_.main_m99_loops) {
+                end_program(r.loc);
+                return;
+            }
+            // S0 §3.4: M99 in the main program returns to its start (or to N n, SUB-8).
+            SourcePos target{};
+            if (r.sequence) {
+                const auto at = find_sequence(*main_, SourcePos{}, *r.sequence, std::nullopt);
+                if (!at) {
+                    main_->seek(after_call);
+                    throw Error(r.loc, "M99 P" + std::to_string(*r.sequence) +
+                                           ": no block N" + std::to_string(*r.sequence) +
+                                           " in the main program");
+                }
+                target = *at;
+            }
+            main_->seek(target);
+            main_started_ = false;
+            return;
+        }
+        CallFrame& top = stack_.back();
+        if (r.sequence) {
+            // SUB-7: return to the caller at N n, searching forward from the call, then from the
+            // start of the calling program.
+            const CallFrame done = top;
+            stack_.pop_back();
+            Source& caller = *done.return_source;
+            const SourcePos caller_start = stack_.empty() ? SourcePos{} : stack_.back().body;
+            std::optional<SourcePos> at =
+                find_sequence(caller, done.return_pos, *r.sequence, std::nullopt);
+            if (!at) at = find_sequence(caller, caller_start, *r.sequence, done.return_pos.offset);
+            if (!at) {
+                stack_.push_back(done);
+                current_->seek(after_call);
+                throw Error(r.loc, "M99 P" + std::to_string(*r.sequence) + ": no block N" +
+                                       std::to_string(*r.sequence) + " in the calling program");
+            }
+            // Queued calls of the same block are dropped: control left that block for good.
+            while (!stack_.empty() && !stack_.back().started) stack_.pop_back();
+            current_ = &caller;
+            current_->seek(*at);
+            return;
+        }
+        if (--top.remaining > 0) {
+            enter(top);
+            return;
+        }
+        const CallFrame done = top;
+        stack_.pop_back();
+        resume_after(done);
+        return;
+    }
+
+    if (call_frame || !customs.empty()) {
+        // Queue so that the written call runs first, then the custom codes in written order.
+        for (std::size_t i = customs.size(); i-- > 0;) {
+            const CustomCall& cc = customs[i];
+            CallFrame f;
+            f.source = library_.get();
+            f.body = cc.site.pos;
+            f.return_source = current_;
+            f.return_pos = after_call;
+            f.label = program_label(cc.program, std::nullopt);
+            f.custom_code = cc.code;
+            stack_.push_back(f);
+        }
+        if (call_frame) {
+            call_frame->return_source = current_;
+            call_frame->return_pos = after_call;
+            stack_.push_back(*call_frame);
+        }
+        enter(stack_.back());
+    }
+}
+
+void Interpreter::enter(CallFrame& frame) {
+    frame.started = true;
+    current_ = frame.source;
+    current_->seek(frame.body);
+    std::string_view label_line;
+    current_->next_line(label_line);  // the O label itself
+}
+
+void Interpreter::resume_after(const CallFrame& done) {
+    if (!stack_.empty() && !stack_.back().started) {
+        enter(stack_.back());
+        return;
+    }
+    current_ = done.return_source;
+    current_->seek(done.return_pos);
+}
+
+}  // namespace interp

@@ -1,0 +1,232 @@
+#include "interp/lexer.hpp"
+
+#include <charconv>
+#include <cstdio>
+#include <string>
+
+#include "interp/text.hpp"
+
+namespace interp {
+
+std::string_view op_text(Op op) {
+    switch (op) {
+        case Op::None: return "";
+        case Op::Plus: return "+";
+        case Op::Minus: return "-";
+        case Op::Star: return "*";
+        case Op::Slash: return "/";
+        case Op::Caret: return "^";
+        case Op::Not: return "!";
+        case Op::Assign: return "=";
+        case Op::EqEq: return "==";
+        case Op::NotEq: return "!=";
+        case Op::Less: return "<";
+        case Op::Greater: return ">";
+        case Op::LessEq: return "<=";
+        case Op::GreaterEq: return ">=";
+        case Op::AndAnd: return "&&";
+        case Op::OrOr: return "||";
+        case Op::Bar: return "|";
+        case Op::LParen: return "(";
+        case Op::RParen: return ")";
+        case Op::LBracket: return "[";
+        case Op::RBracket: return "]";
+        case Op::Comma: return ",";
+    }
+    return "?";
+}
+
+namespace {
+
+constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                             1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                             1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
+// Parses [digits][.digits] starting at s[i]; the caller guarantees a digit or '.' there.
+// Integer mantissas below 2^53 divided by an exact power of ten round once, so the fast path is
+// correctly rounded; longer literals go through from_chars.
+std::size_t scan_number(std::string_view s, std::size_t i, Token& tok) {
+    const std::size_t start = i;
+    std::uint64_t mantissa = 0;
+    int digits = 0;
+    int frac_digits = 0;
+    while (i < s.size() && is_digit(s[i])) {
+        mantissa = mantissa * 10 + static_cast<unsigned>(s[i] - '0');
+        ++digits;
+        ++i;
+    }
+    if (i < s.size() && s[i] == '.') {
+        tok.has_point = true;
+        ++i;
+        while (i < s.size() && is_digit(s[i])) {
+            mantissa = mantissa * 10 + static_cast<unsigned>(s[i] - '0');
+            ++digits;
+            ++frac_digits;
+            ++i;
+        }
+    }
+    tok.kind = Tok::Number;
+    tok.text = s.substr(start, i - start);
+    if (digits <= 15) {
+        tok.number = static_cast<double>(mantissa) / kPow10[frac_digits];
+    } else {
+        std::string_view t = tok.text;
+        std::string buf;
+        if (t.front() == '.') {
+            buf = "0" + std::string(t);
+            t = buf;
+        }
+        if (t.back() == '.') t.remove_suffix(1);
+        double v = 0.0;
+        std::from_chars(t.data(), t.data() + t.size(), v);
+        tok.number = v;
+    }
+    return i;
+}
+
+// Two-character operators first, then single characters.
+Op scan_op(std::string_view s, std::size_t i, bool abs_bars, std::size_t& len) {
+    const char c = s[i];
+    const char n = i + 1 < s.size() ? s[i + 1] : '\0';
+    len = 2;
+    if (c == '=' && n == '=') return Op::EqEq;
+    if (c == '!' && n == '=') return Op::NotEq;
+    if (c == '<' && n == '=') return Op::LessEq;
+    if (c == '>' && n == '=') return Op::GreaterEq;
+    if (c == '&' && n == '&') return Op::AndAnd;
+    if (c == '|' && n == '|' && !abs_bars) return Op::OrOr;
+    len = 1;
+    switch (c) {
+        case '+': return Op::Plus;
+        case '-': return Op::Minus;
+        case '*': return Op::Star;
+        case '/': return Op::Slash;
+        case '^': return Op::Caret;
+        case '!': return Op::Not;
+        case '=': return Op::Assign;
+        case '<': return Op::Less;
+        case '>': return Op::Greater;
+        case '|': return abs_bars ? Op::Bar : Op::None;
+        case '(': return Op::LParen;
+        case ')': return Op::RParen;
+        case '[': return Op::LBracket;
+        case ']': return Op::RBracket;
+        case ',': return Op::Comma;
+        default: return Op::None;
+    }
+}
+
+// A '(' opens a sub-expression when it follows something that needs an operand or an argument
+// list; anywhere else it opens a comment (CAM output writes "(…)" comments).
+bool paren_is_expression(const std::vector<Token>& out, int depth, bool expression_start) {
+    if (depth > 0) return true;
+    if (out.empty()) return expression_start;
+    const Token& prev = out.back();
+    if (prev.kind == Tok::Word) return prev.text.size() > 1;
+    if (prev.kind == Tok::Op)
+        return prev.op != Op::RParen && prev.op != Op::RBracket && prev.op != Op::Bar;
+    return false;
+}
+
+std::string describe_byte(char c) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u >= 0x20 && u < 0x7F) return std::string("unexpected character '") + c + "'";
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "unexpected byte 0x%02X", u);
+    return std::string(buf) + (u >= 0x80 ? " (non-ASCII text belongs in a ' comment or a string)"
+                                         : "");
+}
+
+}  // namespace
+
+void Lexer::lex(std::string_view s, const SourceLoc& loc, std::vector<Token>& out,
+                bool expression_start) const {
+    out.clear();
+    const Dialect& d = *dialect_;
+    std::size_t i = 0;
+    int depth = 0;
+    bool space = false;
+    auto error = [&](std::size_t at, const std::string& msg) {
+        throw Error(SourceLoc{loc.file, loc.line, static_cast<int>(at) + 1}, msg);
+    };
+    while (i < s.size()) {
+        const char c = s[i];
+        if (is_space(c)) {
+            space = true;
+            ++i;
+            continue;
+        }
+        if (c == ';') break;
+        if (d.quote_comments && comment_quote_length(s.substr(i)) != 0) break;
+        Token tok;
+        tok.col = static_cast<int>(i) + 1;
+        tok.space_before = space;
+        space = false;
+        if (is_alpha(c)) {
+            std::size_t j = i;
+            while (j < s.size() && is_alpha(s[j])) ++j;
+            tok.kind = Tok::Word;
+            tok.text = s.substr(i, j - i);
+            i = j;
+        } else if (is_digit(c) || (c == '.' && i + 1 < s.size() && is_digit(s[i + 1]))) {
+            i = scan_number(s, i, tok);
+        } else if (c == '#') {
+            std::size_t j = i + 1;
+            if (j < s.size() && is_digit(s[j])) {
+                while (j < s.size() && is_digit(s[j])) ++j;
+            } else if (j < s.size() && (is_alpha(s[j]) || s[j] == '_')) {
+                while (j < s.size() && (is_alpha(s[j]) || is_digit(s[j]) || s[j] == '_')) ++j;
+                // Axis suffix ".X"; S0 §4.1.1 prints "#CTP_POS. X", so a space may follow the dot.
+                if (j < s.size() && s[j] == '.') {
+                    std::size_t k = j + 1;
+                    while (d.tolerant_expr_spaces && k < s.size() && is_space(s[k])) ++k;
+                    if (k < s.size() && is_alpha(s[k])) {
+                        j = k;
+                        while (j < s.size() && is_alpha(s[j])) ++j;
+                    }
+                }
+            } else {
+                error(i, "expected a variable number or parameter name after '#'");
+            }
+            tok.kind = Tok::Var;
+            tok.text = s.substr(i + 1, j - i - 1);
+            i = j;
+        } else if (const std::size_t q = quote_length(s.substr(i)); q != 0) {
+            std::size_t j = i + q;
+            while (j < s.size() && quote_length(s.substr(j)) == 0) ++j;
+            if (j >= s.size()) error(i, "unterminated string (missing closing quote)");
+            tok.kind = Tok::String;
+            tok.text = s.substr(i + q, j - i - q);
+            i = j + quote_length(s.substr(j));
+        } else if (c == '(' && !paren_is_expression(out, depth, expression_start)) {
+            if (!d.paren_comments) error(i, "'(' comments are not allowed in this dialect");
+            int nest = 0;
+            std::size_t j = i;
+            for (; j < s.size(); ++j) {
+                if (s[j] == '(' && (nest == 0 || d.nested_paren_comments)) ++nest;
+                if (s[j] == ')' && --nest == 0) break;
+            }
+            if (j >= s.size()) error(i, "unclosed '(' comment");
+            i = j + 1;
+            space = true;
+            continue;
+        } else {
+            std::size_t len = 0;
+            const Op op = scan_op(s, i, d.abs_bars, len);
+            if (op == Op::None) error(i, describe_byte(c));
+            if (op == Op::LParen) ++depth;
+            if (op == Op::RParen && depth > 0) --depth;
+            tok.kind = Tok::Op;
+            tok.op = op;
+            tok.text = s.substr(i, len);
+            i += len;
+        }
+        out.push_back(tok);
+    }
+    Token end;
+    end.col = static_cast<int>(i) + 1;
+    end.space_before = true;
+    out.push_back(end);
+}
+
+}  // namespace interp

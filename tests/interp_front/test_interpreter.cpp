@@ -1,0 +1,340 @@
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "fakes.hpp"
+#include "interp/interpreter.hpp"
+
+using namespace interp;
+
+namespace {
+
+struct InterpFixture : ::testing::Test {
+    test::FakeMachine machine;
+    test::RecordingExecutor exec;
+    InterpreterOptions options;
+    std::unique_ptr<Interpreter> interp;
+
+    Interpreter& start(std::string text, bool with_library = false) {
+        interp = std::make_unique<Interpreter>(exec, machine, options);
+        if (with_library) interp->load_library(INTERP_FRONT_DATA_DIR "/public.dat");
+        interp->open(Source::from_string("main.nc", std::move(text)));
+        return *interp;
+    }
+    void run(std::string text, bool with_library = false) { start(std::move(text), with_library).run(); }
+    std::string run_error(std::string text, bool with_library = false) {
+        try {
+            run(std::move(text), with_library);
+        } catch (const Error& e) {
+            return e.what();
+        }
+        return "no error";
+    }
+    // Runs to the end like `cnc check`: every error is collected and interpretation continues.
+    std::vector<std::string> check(std::string text) {
+        std::vector<std::string> errors;
+        Interpreter& in = start(std::move(text));
+        for (int guard = 0; guard < 10000; ++guard) {
+            try {
+                if (!in.step()) break;
+            } catch (const Error& e) {
+                errors.push_back(e.what());
+            }
+        }
+        return errors;
+    }
+    std::vector<std::string> files() const {
+        std::vector<std::string> out;
+        for (const Block& b : exec.blocks) out.emplace_back(b.loc.file);
+        return out;
+    }
+};
+
+using Lines = std::vector<int>;
+using Values = std::vector<double>;
+
+}  // namespace
+
+TEST_F(InterpFixture, RunsBlocksInOrderAndStopsAtM30) {
+    run("G0 X1\n' comment\n\nG1 X2 F100\nM30\nG0 X99\n");
+    EXPECT_EQ(exec.lines(), (Lines{1, 4, 5}));
+    EXPECT_EQ(exec.values('X'), (Values{1, 2}));
+    EXPECT_TRUE(exec.ends.empty());  // M30 is a normal end passed as a block
+    EXPECT_TRUE(interp->finished());
+    EXPECT_FALSE(interp->step());
+}
+
+TEST_F(InterpFixture, M02EndsTheProgram) {
+    run("G0 X1\nM02\nG0 X2\n");
+    EXPECT_EQ(exec.lines(), (Lines{1, 2}));
+}
+
+TEST_F(InterpFixture, EndOfFileWithoutM30CallsEndOfInput) {
+    run("G0 X1\nG0 X2");
+    EXPECT_EQ(exec.lines(), (Lines{1, 2}));
+    ASSERT_EQ(exec.ends.size(), 1u);
+    EXPECT_EQ(exec.ends[0].line, 3);
+}
+
+TEST_F(InterpFixture, LeadingLabelNamesTheMainProgram) {
+    run("O0001\nG1 X1\nM30\n");
+    EXPECT_EQ(exec.lines(), (Lines{2, 3}));
+}
+
+TEST_F(InterpFixture, MainProgramEndsAtFirstSubprogramLabel) {
+    run("G1 X1\nO10\nG1 X2\nM17\n");
+    EXPECT_EQ(exec.lines(), (Lines{1}));
+    ASSERT_EQ(exec.ends.size(), 1u);
+    EXPECT_EQ(exec.ends[0].line, 2);
+}
+
+TEST_F(InterpFixture, G65RepeatsSubprogramLTimes) {
+    run("G0 X0\nG65 P9001 L3\nG0 X9\nM30\nO9001\nG91 G1 X1\nM17\n");
+    EXPECT_EQ(exec.lines(), (Lines{1, 6, 6, 6, 3, 4}));
+}
+
+TEST_F(InterpFixture, G65LZeroCallsNothing) {
+    run("G65 P9001 L0\nM30\nO9001\nG1 X1\nM17\n");
+    EXPECT_EQ(exec.lines(), (Lines{2}));
+}
+
+TEST_F(InterpFixture, OtherCodesOfACallBlockRunFirst) {
+    run("G91 G65 P5\nM30\nO5\nG1 X1\nM17\n");
+    ASSERT_EQ(exec.blocks.size(), 3u);
+    EXPECT_EQ(exec.blocks[0].g[0], 910);  // G91 before the body
+    EXPECT_EQ(exec.blocks[1].loc.line, 4);
+}
+
+// Nested repeats multiply: O2 runs 2 times and calls O3 3 times each run (S0 §3.5.1 G992 arrays).
+TEST_F(InterpFixture, NestedRepeatsMultiply) {
+    run("G65 P2 L2\nM30\nO2\nG65 P3 L=1+2\nG0 Y1\nM17\nO3\nG0 X1\nM17\n");
+    EXPECT_EQ(exec.lines(), (Lines{8, 8, 8, 5, 8, 8, 8, 5, 2}));
+}
+
+TEST_F(InterpFixture, NamedSubprogram) {
+    run("G65 P\"Frame\" L2\nM30\nO\"frame\"\nG1 X1\nM17\n");
+    EXPECT_EQ(exec.lines(), (Lines{4, 4, 2}));
+}
+
+TEST_F(InterpFixture, SubprogramVariablesAreProgramGlobal) {
+    run("#1=30 #3=2\nG65 P3456 L=#3\nG0 X=#1\nM30\nO3456\n#1=#1+1\nM17\n");
+    EXPECT_EQ(exec.values('X'), (Values{32}));
+}
+
+TEST_F(InterpFixture, M98CallsWithFanucCountForm) {
+    run("M98 P30021\nM30\nO21\nG1 X1\nM99\n");
+    EXPECT_EQ(exec.lines(), (Lines{4, 4, 4, 2}));
+}
+
+TEST_F(InterpFixture, M99WithSequenceReturnsToThatBlockOfTheCaller) {
+    // Forward from the call: N30 is after the calling block, N20 is skipped.
+    run("N10 G65 P7\nN20 G0 X20\nN30 G0 X30\nM30\nO7\nG1 X7\nM99 P30\n");
+    EXPECT_EQ(exec.values('X'), (Values{7, 30}));
+    EXPECT_EQ(exec.lines(), (Lines{6, 3, 4}));
+}
+
+TEST_F(InterpFixture, M99SequenceSearchWrapsToProgramStart) {
+    // N5 lies before the call: found by the second search from the start (SUB-7).
+    run("#1=0\nN5 #1=#1+1\nIF(#1>2) M30\nG65 P7\nM30\nO7\nG1 X=#1\nM99 P5\n");
+    EXPECT_EQ(exec.values('X'), (Values{1, 2}));
+    EXPECT_EQ(exec.lines(), (Lines{7, 7, 3}));
+}
+
+TEST_F(InterpFixture, M99InMainRestartsTheProgram) {
+    options.main_m99_loops = true;
+    Interpreter& in = start("G1 X1\nG1 X2 M99\nG1 X3\n");
+    for (int i = 0; i < 6; ++i) in.step();
+    EXPECT_EQ(exec.lines(), (Lines{1, 2, 1, 2, 1, 2}));
+    EXPECT_FALSE(in.finished());
+}
+
+TEST_F(InterpFixture, M99InMainEndsWhenLoopingIsOff) {
+    options.main_m99_loops = false;
+    run("G1 X1\nM99\nG1 X3\n");
+    EXPECT_EQ(exec.lines(), (Lines{1}));
+    EXPECT_EQ(exec.ends.size(), 1u);
+}
+
+TEST_F(InterpFixture, M99WithSequenceInMainJumps) {
+    Interpreter& in = start("N1 G1 X1\nN2 G1 X2\nM99 P2\n");
+    for (int i = 0; i < 6; ++i) in.step();  // N1, N2, M99, N2, M99, N2
+    EXPECT_EQ(exec.lines(), (Lines{1, 2, 2, 2}));
+}
+
+TEST_F(InterpFixture, M02InsideSubprogramEndsEverything) {
+    run("G65 P1\nG0 X9\nM30\nO1\nG1 X1\nM02\nM17\n");
+    EXPECT_EQ(exec.lines(), (Lines{5, 6}));
+    EXPECT_EQ(interp->call_depth(), 0);
+}
+
+TEST_F(InterpFixture, BlockDeleteSkipsSlashLinesWhenOn) {
+    options.block_delete = true;
+    run("G1 X1\n/G1 X2 #1=5\nG1 X3\n");
+    EXPECT_EQ(exec.values('X'), (Values{1, 3}));
+    EXPECT_FALSE(interp->variables().numbered_if_set(1));
+    options.block_delete = false;
+    exec.blocks.clear();
+    run("G1 X1\n/G1 X2\n");
+    EXPECT_EQ(exec.values('X'), (Values{1, 2}));
+}
+
+TEST_F(InterpFixture, IfFalseSkipsBlock) {
+    run("#1=0\nIF(#1) G1 X1\nIF(!#1) G1 X2\n");
+    EXPECT_EQ(exec.values('X'), (Values{2}));
+}
+
+// A block the back end rejects changes no state: its assignments are rolled back, and the
+// interpreter continues with the next line when asked to.
+TEST_F(InterpFixture, RejectedBlockChangesNoState) {
+    exec.reject_line = 2;
+    Interpreter& in = start("#1=1\n#1=5 G1 X=#1\nG1 Y=#1\n");
+    EXPECT_TRUE(in.step());
+    EXPECT_THROW(in.step(), Error);
+    EXPECT_EQ(*in.variables().numbered_if_set(1), 1.0);
+    EXPECT_TRUE(in.step() || in.finished());
+    EXPECT_EQ(exec.values('Y'), (Values{1}));
+}
+
+TEST_F(InterpFixture, CheckModeReportsEveryError) {
+    const auto errors = check("G1 X1\nG1 X=1/0\nG1 X2\nG65 P404\nG1 Y2 Y3\nM30\n");
+    EXPECT_EQ(errors, (std::vector<std::string>{"main.nc:2:7: division by zero",
+                                                "main.nc:4:1: subprogram O404 not found",
+                                                "main.nc:5:7: word Y appears twice in one block"}));
+    EXPECT_EQ(exec.lines(), (Lines{1, 3, 6}));
+}
+
+TEST_F(InterpFixture, ErrorSubprogramNotFound) {
+    EXPECT_EQ(run_error("G0 X1\nG65 P\"nope\"\n"), "main.nc:2:1: subprogram O\"nope\" not found");
+    EXPECT_EQ(exec.lines(), (Lines{1}));  // the failing block did not run its other words
+}
+
+TEST_F(InterpFixture, ErrorM17OutsideSubprogram) {
+    EXPECT_EQ(run_error("G0 X1\nM17\n"), "main.nc:2:1: M17 outside a subprogram");
+}
+
+TEST_F(InterpFixture, ErrorSubprogramRunsIntoNextLabel) {
+    EXPECT_EQ(run_error("G65 P1\nM30\nO1\nG1 X1\nO2\nM17\n"),
+              "main.nc:5:1: subprogram O1 runs into the next label without M17");
+}
+
+TEST_F(InterpFixture, ErrorSubprogramEndsWithoutM17) {
+    EXPECT_EQ(run_error("G65 P1\nM30\nO1\nG1 X1\n"), "main.nc:5:1: subprogram O1 ends without M17");
+    EXPECT_TRUE(interp->finished());
+}
+
+TEST_F(InterpFixture, ErrorRecursionTooDeep) {
+    EXPECT_EQ(run_error("G65 P1\nM30\nO1\nG65 P1\nM17\n"),
+              "main.nc:4:1: subprogram calls nested deeper than 64 levels");
+}
+
+TEST_F(InterpFixture, ErrorM99TargetMissing) {
+    EXPECT_EQ(run_error("G65 P7\nM30\nO7\nM99 P44\n"),
+              "main.nc:4:1: M99 P44: no block N44 in the calling program");
+    EXPECT_EQ(run_error("G1 X1\nM99 P44\n"), "main.nc:2:1: M99 P44: no block N44 in the main program");
+}
+
+// S0 §4.2 custom M codes from public.dat (EX-26): M03 runs O203 after the block's motion; M05
+// and M08 run O205 and O208 in written order; M07 has no subprogram and stays a plain code.
+TEST_F(InterpFixture, PublicDatCustomMCodes) {
+    run("G0 X1 M03\nM07\nM05 M08\nM30\n", true);
+    std::vector<std::string> seen;
+    for (const Block& b : exec.blocks) {
+        std::string s = std::string(b.loc.file == "main.nc" ? "main" : "lib") + ":";
+        for (int m : b.m) s += "M" + std::to_string(m) + " ";
+        for (int g : b.g) s += "G" + std::to_string(g / 10) + " ";
+        if (b.has('H')) s += "H" + std::to_string(static_cast<int>(b.get('H'))) + " ";
+        if (b.has('P')) s += "P" + std::to_string(static_cast<int>(b.get('P')));
+        seen.push_back(s);
+    }
+    EXPECT_EQ(seen, (std::vector<std::string>{
+                        "main:G0 ",           // the block's motion first
+                        "lib:M901 H2 P1",      // O203
+                        "lib:G4 P5",
+                        "lib:M3 ",             // M03 inside O203 is the built-in code
+                        "main:M7 ",
+                        "lib:M901 H2 P0",      // O205, then O208 in written order
+                        "lib:G4 P5",
+                        "lib:M901 H24 P1",
+                        "lib:G4 P5",
+                        "main:M30 ",
+                    }));
+}
+
+// S0 §4.1.1 example 2 (EX-25): custom G86 with retract. G90 G99 G86 X10 Y10 Z-10 R2 Q3 F300
+// with FIXEDCYCLE_BACK=1 must rapid to (10,10), rapid to R2, feed to -1, then
+// int(|2-(-10)|/3)-1 = 3 times {rapid +1, rapid -1, feed -3}, feed to -10, M05, rapid to R2,
+// stay at R (G99) and M03.
+TEST_F(InterpFixture, PublicDatCustomG86WithRetract) {
+    machine.settings["FIXEDCYCLE_BACK"] = 1.0;
+    machine.return_to_r = true;   // G99, as the back end would report after the block's G99
+    machine.incremental = false;  // G90
+    machine.work_mm[2] = 10.0;    // initial Z
+    run("G90 G99 G86 X10 Y10 Z-10 R2 Q3 F300\nM30\n", true);
+    ASSERT_GE(exec.blocks.size(), 2u);
+    const Block& first = exec.blocks[0];
+    EXPECT_EQ(first.g.size(), 2u);  // G90 G99 act first; X Y Z R Q F went to #FC1…#FC7
+    EXPECT_FALSE(first.has('X'));
+    EXPECT_EQ(exec.values('Z'), (Values{2, -1, 1, -1, -3, 1, -1, -3, 1, -1, -3, -10, 2}));
+    EXPECT_EQ(exec.values('X'), (Values{10}));
+    EXPECT_EQ(exec.values('F'), (Values{300, 300, 300, 300, 300}));
+    std::vector<int> ms;
+    for (const Block& b : exec.blocks)
+        for (int m : b.m) ms.push_back(m);
+    // M05 and M03 inside O786 are themselves custom codes of this library: O205 and O203 run
+    // (M901 each), and the M03 inside O203 is the built-in code.
+    EXPECT_EQ(ms, (std::vector<int>{901, 901, 3, 30}));
+    EXPECT_EQ(interp->variables().fixed_cycle(14, {}), 10.0);
+    EXPECT_EQ(interp->variables().fixed_cycle(11, {}), 0.0);
+}
+
+TEST_F(InterpFixture, LibrarySubprogramCallableByG65) {
+    run("G65 P\"helper\"\nM30\n", true);
+    EXPECT_EQ(exec.values('X'), (Values{77}));
+    EXPECT_EQ(files()[0], INTERP_FRONT_DATA_DIR "/public.dat");
+}
+
+TEST_F(InterpFixture, ProgramSubprogramWinsOverLibrary) {
+    run("G65 P\"helper\"\nM30\nO\"helper\"\nG1 X5\nM17\n", true);
+    EXPECT_EQ(exec.values('X'), (Values{5}));
+}
+
+// No globals: two interpreters interleaved keep their own variables, stacks and positions.
+TEST(InterpreterIsolation, TwoInterpretersSideBySide) {
+    test::FakeMachine m1, m2;
+    test::RecordingExecutor e1, e2;
+    Interpreter a(e1, m1), b(e2, m2);
+    a.open(Source::from_string("a.nc", "#1=1\nG65 P1 L2\nG0 X=#1\nM30\nO1\n#1=#1*10\nM17\n"));
+    b.open(Source::from_string("b.nc", "#1=2\nG65 P1 L2\nG0 X=#1\nM30\nO1\n#1=#1+1\nM17\n"));
+    bool more_a = true, more_b = true;
+    while (more_a || more_b) {
+        if (more_a) more_a = a.step();
+        if (more_b) more_b = b.step();
+    }
+    EXPECT_EQ(e1.values('X'), (Values{100}));
+    EXPECT_EQ(e2.values('X'), (Values{4}));
+}
+
+// Streaming: a 300k-line program runs with the source read through a fixed window.
+TEST(InterpreterStreaming, LargeFileWithSubprogramAtTheEnd) {
+    const std::string path =
+        ::testing::TempDir() + "ifront_big_" + std::to_string(::getpid()) + ".nc";
+    {
+        std::ofstream f(path);
+        f << "G65 P9 L2\n";
+        for (int i = 0; i < 300000; ++i) f << "G1 X" << (i % 100) << " Y1.5 Z-0.5 F1000\n";
+        f << "M30\nO9\nG0 Z5\nM17\n";
+    }
+    test::FakeMachine m;
+    test::RecordingExecutor e;
+    Interpreter in(e, m);
+    in.open(path);
+    in.run();
+    EXPECT_EQ(e.blocks.size(), 300003u);
+    EXPECT_EQ(e.blocks[0].get('Z'), 5.0);
+    EXPECT_EQ(e.blocks[1].get('Z'), 5.0);
+    EXPECT_EQ(e.blocks.back().loc.line, 300002);
+    ::unlink(path.c_str());
+}
