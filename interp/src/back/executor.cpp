@@ -139,6 +139,7 @@ private:
     void step_io();
     void step_dwell();
     void step_plane();
+    void announce_units();
     void step_tool_length();
     void step_wcs();
     void step_distance();
@@ -236,7 +237,8 @@ const BlockRun::Step BlockRun::kSteps[] = {
     &BlockRun::validate,       &BlockRun::announce_start,     &BlockRun::step_units,
     &BlockRun::step_feed,      &BlockRun::step_spindle_speed, &BlockRun::step_tool,
     &BlockRun::step_spindle,   &BlockRun::step_coolant,       &BlockRun::step_io,
-    &BlockRun::step_dwell,     &BlockRun::step_plane,         &BlockRun::step_tool_length,
+    &BlockRun::step_dwell,     &BlockRun::step_plane,         &BlockRun::announce_units,
+    &BlockRun::step_tool_length,
     &BlockRun::step_wcs,       &BlockRun::step_distance,      &BlockRun::step_transforms,
     &BlockRun::step_settings_writes, &BlockRun::step_machine_codes, &BlockRun::step_motion,
     &BlockRun::step_stop,
@@ -372,10 +374,14 @@ void BlockRun::step_units() {
     double mpu = st.units.mm_per_unit;
     if (g(gcode(20)) || g(gcode(70))) mpu = 25.4;
     if (g(gcode(21)) || g(gcode(71))) mpu = 1.0;
-    const bool written = g(gcode(20)) || g(gcode(70)) || g(gcode(21)) || g(gcode(71));
-    if (!written) return;
     st.units.mm_per_unit = mpu;
-    emit(canon::Units{st.units.inch()});
+}
+
+// Announced after the plane, in LinuxCNC's order, though the value applied from the start of the
+// block (F and every length of the block are in the new units).
+void BlockRun::announce_units() {
+    if (g(gcode(20)) || g(gcode(70)) || g(gcode(21)) || g(gcode(71)))
+        emit(canon::Units{st.units.inch()});
 }
 
 // F in a block whose motion mode is G00 sets the rapid speed only (G00-3).
