@@ -257,6 +257,15 @@ TEST(CutterComp, CancelInABlockWithoutPlaneMotionReturnsToTheProgrammedPoint) {
     EXPECT_FALSE(c.active());
 }
 
+TEST(CutterComp, NegativeRadiusSwapsTheSide) {
+    // G41 with a radius of −1 offsets to the right, like G42 with 1.
+    Compensator c(Config{}, {-5, 0});
+    const Lines out =
+        run(c, {line(0, 0, L, -1, 1), line(10, 0, L, -1, 2), line(15, 0, Off, -1, 3)});
+    EXPECT_EQ(out, (Lines{"L -5,0 -> 0,-1 startup #1", "L 0,-1 -> 10,-1 contour #2",
+                          "L 10,-1 -> 15,0 cancel #3"}));
+}
+
 TEST(CutterComp, ProgramEndWithCompensationActiveWarns) {
     Compensator c(Config{}, {-5, 0});
     const Lines out = run(c, {line(0, 0, L, 1, 1), line(10, 0, L, 1, 2)});

@@ -76,7 +76,7 @@ struct Move {
     double end_h = 0.0;
     bool rapid = false;
     Side side = Side::Off;   // G40/G41/G42 in effect for this block
-    double radius_mm = 0.0;  // tool radius (from D), ≥ 0
+    double radius_mm = 0.0;  // tool radius (from D); negative swaps G41/G42 (CRC-7)
     int plane = 17;          // G17/G18/G19; must not change while compensation is active
     SourceTag tag = 0;
 };

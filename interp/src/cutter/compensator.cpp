@@ -76,7 +76,13 @@ void Compensator::push(const Marker& marker) {
         out_.emplace_back(OutMarker{marker.tag});
 }
 
-void Compensator::push(const Move& move) {
+void Compensator::push(const Move& programmed) {
+    // CRC-7: a negative radius swaps G41 and G42.
+    Move move = programmed;
+    if (move.radius_mm < 0) {
+        move.radius_mm = -move.radius_mm;
+        if (move.side != Side::Off) move.side = move.side == Side::Left ? Side::Right : Side::Left;
+    }
     const Segment seg = Segment::make(programmed_, programmed_h_, move);
     if (pending_ && move.plane != pending_->move.plane)
         throw CompError(fmt::format("cutter comp: the plane changed from G{} to G{} while "
