@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace {
@@ -198,6 +199,57 @@ TEST(CutterComp, HelixOffsetInPlaneHeightFollows) {
     h.end_h = -3;
     const Lines out = run(c, {line(10, 0, L, 2, 1), h, line(0, 0, Off, 2, 3)});
     EXPECT_EQ(out[1], "A 8,0 -> 8,0 c0,0 ccw 360deg h0->-3 contour #2");
+}
+
+TEST(CutterComp, ManualExample2Obround) {
+    // S0 §3.12 example 2 (EX-19) with D01 = 5: the contour runs clockwise, so G41
+    // (left) is outside: the CW arcs grow to radius 30 and the lines move out by 5.
+    // Start-up ends on the perpendicular of the first arc at (45,15): its tangent
+    // there is −X, left of that is −Y, so (45,10). All joints are tangent.
+    Compensator c;
+    EXPECT_EQ(
+        run(c, {line(45, 15, L, 5, 2, true), arc(45, 65, 45, 40, false, L, 5, 3),
+                line(135, 65, L, 5, 4), arc(135, 15, 135, 40, false, L, 5, 5),
+                line(45, 15, L, 5, 6), line(0, 0, Off, 5, 7, true)}),
+        (Lines{"L 0,0 -> 45,10 startup #2", "A 45,10 -> 45,70 c45,40 cw 180deg contour #3",
+               "L 45,70 -> 135,70 contour #4", "A 135,70 -> 135,10 c135,40 cw 180deg contour #5",
+               "L 135,10 -> 45,10 contour #6", "L 45,10 -> 0,0 cancel #7"}));
+}
+
+TEST(CutterComp, ManualExample3NotchCornersAreInsideCorners) {
+    // S0 §3.12 example 3 (EX-20), absolute points, D = 5, G41 (outside of this
+    // clockwise contour). The notch (100,120)→(100,70)→(140,70)→(140,120) turns
+    // left twice: inside corners at (105,75) and (135,75); its top corners turn
+    // right: outside, arcs about (100,120) and (140,120).
+    Compensator c;
+    const Lines out = run(
+        c, {line(40, 30, L, 5, 2, true), line(40, 100, L, 5, 3),
+            arc(60, 120, 60, 100, false, L, 5, 4), line(100, 120, L, 5, 5), line(100, 70, L, 5, 6),
+            line(140, 70, L, 5, 7), line(140, 120, L, 5, 8), line(210, 120, L, 5, 9),
+            line(210, 80, L, 5, 10), arc(160, 30, 210, 30, true, L, 5, 11), line(40, 30, L, 5, 12),
+            line(0, 0, Off, 5, 13, true)});
+    const Lines expected_parts{"L 0,0 -> 35,30 startup #2",
+                               "L 35,30 -> 35,100 contour #3",
+                               "A 35,100 -> 60,125 c60,100 cw 90deg contour #4",
+                               "L 60,125 -> 100,125 contour #5",
+                               "A 100,125 -> 105,120 c100,120 cw 90deg corner #6",
+                               "L 105,120 -> 105,75 contour #6",
+                               "L 105,75 -> 135,75 contour #7",
+                               "L 135,75 -> 135,120 contour #8",
+                               "A 135,120 -> 140,125 c140,120 cw 90deg corner #9",
+                               "L 140,125 -> 210,125 contour #9",
+                               "A 210,125 -> 215,120 c210,120 cw 90deg corner #10",
+                               "L 215,120 -> 215,80 contour #10",
+                               "L 40,25 -> 0,0 cancel #13"};
+    for (const auto& part : expected_parts)
+        EXPECT_NE(std::find(out.begin(), out.end(), part), out.end()) << part;
+    // The CCW arc about (210,30) with the tool on its left (centre side) shrinks to
+    // 45; it starts heading −X after line 10 heads −Y: a right turn, outside.
+    for (const char* part :
+         {"A 215,80 -> 210,75 c210,80 cw 90deg corner #11",
+          "A 210,75 -> 165,30 c210,30 ccw 90deg contour #11",
+          "A 165,30 -> 160,25 c160,30 cw 90deg corner #12", "L 160,25 -> 40,25 contour #12"})
+        EXPECT_NE(std::find(out.begin(), out.end(), part), out.end()) << part;
 }
 
 TEST(CutterComp, ZMovesAndMarkersWaitAtTheCorner) {

@@ -246,6 +246,28 @@ TEST(CycleData, IncrementalRepeatDrillsEquallySpacedHoles) {
     EXPECT_EQ(next[2], "feed X40 Y34.642 Z-15 F4000");
 }
 
+TEST(CycleData, ManualExample4LeftHandTappingL2) {
+    // S0 §3.12 example 4 (EX-21): after G92 X0 Y0 Z0 and "G91 G00 X-35 Y15 M04",
+    // "G74 X50 Y0 Z-28 R-5 P1000 F1000 L2" under G91: R = 0 − 5, Z = R − 28 = −33,
+    // two holes 50 apart at X15 and X65, each returning to the initial level 0
+    // (G98). The following G00 blocks cancel the cycle (CC-13), so only 2 taps.
+    Session s;
+    s.ctx.position_mm = {-35, 15, 0};
+    s.ctx.incremental = true;
+    s.ctx.spindle = Spindle::Ccw;
+    s.ctx.feed_mm_min = 1000;
+    Lines expected;
+    for (const char* x : {"X15", "X65"}) {
+        const std::string xy = std::string(x) + " Y15";
+        for (const std::string& line :
+             {"rapid " + xy + " Z0", "rapid " + xy + " Z-5", "feed " + xy + " Z-33 F1000",
+              std::string("dwell 1s"), std::string("spindle reverse"), "feed " + xy + " Z-5 F1000",
+              std::string("dwell 1s"), std::string("spindle reverse"), "rapid " + xy + " Z0"})
+            expected.push_back(line);
+    }
+    EXPECT_EQ(s.run(CycleCode::G74, Words().x(50).y(0).z(-28).r(-5).p(1000).k(2)), expected);
+}
+
 TEST(CycleData, AbsoluteRepeatDrillsTheSameHoleAgain) {
     Session s;
     s.ctx.return_to_r = true;
