@@ -12,7 +12,7 @@ namespace interp::test {
 
 // Answers from plain fields the test sets.
 class FakeMachine : public MachineQuery {
-public:
+  public:
     std::array<double, kMachineAxes> machine_mm{};
     std::array<double, kMachineAxes> work_mm{};
     std::uint64_t inputs = 0;
@@ -40,7 +40,7 @@ public:
 
 // Records every executed block; can be told to reject a block at a given line.
 class RecordingExecutor : public BlockExecutor {
-public:
+  public:
     std::vector<Block> blocks;
     std::vector<SourceLoc> ends;
     int reject_line = -1;

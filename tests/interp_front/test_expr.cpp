@@ -22,8 +22,10 @@ struct ExprFixture : ::testing::Test {
         TokenCursor cur{&tokens, 0};
         ExprEvaluator ev(d, vars, machine, "e.nc", 3);
         const double v = ev.evaluate(cur);
-        if (rest != nullptr) *rest = cur.at_end() ? 0 : cur.peek().col;
-        else EXPECT_TRUE(cur.at_end()) << "unparsed text after expression in: " << text;
+        if (rest != nullptr)
+            *rest = cur.at_end() ? 0 : cur.peek().col;
+        else
+            EXPECT_TRUE(cur.at_end()) << "unparsed text after expression in: " << text;
         return v;
     }
     std::string error(std::string_view text, const Dialect& d = ncstudio_dialect()) {
@@ -43,8 +45,8 @@ struct ExprFixture : ::testing::Test {
 TEST_F(ExprFixture, ArithmeticPrecedenceAndAssociativity) {
     EXPECT_EQ(eval("2+3*4"), 14.0);
     EXPECT_EQ(eval("(2+3)*4"), 20.0);
-    EXPECT_EQ(eval("10-4-3"), 3.0);   // left-associative, not 10-(4-3)=9
-    EXPECT_EQ(eval("24/4/2"), 3.0);   // left-associative, not 24/(4/2)=12
+    EXPECT_EQ(eval("10-4-3"), 3.0);  // left-associative, not 10-(4-3)=9
+    EXPECT_EQ(eval("24/4/2"), 3.0);  // left-associative, not 24/(4/2)=12
     EXPECT_EQ(eval("-2*3"), -6.0);
     EXPECT_EQ(eval("--2"), 2.0);
     EXPECT_EQ(eval("+5-+2"), 3.0);
@@ -91,9 +93,9 @@ TEST_F(ExprFixture, Functions) {
     EXPECT_EQ(eval("int(-2.5)"), -3.0);  // rounds down, not toward zero
     EXPECT_EQ(eval("int(-3)"), -3.0);
     EXPECT_EQ(eval("abs(-3.5)"), 3.5);
-    EXPECT_EQ(eval("ABS(-1)+Int(1.5)"), 2.0);  // case-insensitive names
+    EXPECT_EQ(eval("ABS(-1)+Int(1.5)"), 2.0);                // case-insensitive names
     EXPECT_NEAR(eval("sin(3.14159265358979)"), 0.0, 1e-12);  // radians, not degrees
-    EXPECT_EQ(eval("sqrt16*2"), 8.0);  // bare-literal call binds before *
+    EXPECT_EQ(eval("sqrt16*2"), 8.0);                        // bare-literal call binds before *
 }
 
 TEST_F(ExprFixture, VariablesAndNamedParameters) {
@@ -151,7 +153,8 @@ TEST_F(ExprFixture, ErrorDivisionByZero) {
     EXPECT_EQ(error("1/(2-2)"), "e.nc:3:2: division by zero");
 }
 TEST_F(ExprFixture, ErrorSqrtNegative) {
-    EXPECT_EQ(error("sqrt(-4)"), "e.nc:3:1: sqrt: square root of a negative number (argument -4.000000)");
+    EXPECT_EQ(error("sqrt(-4)"),
+              "e.nc:3:1: sqrt: square root of a negative number (argument -4.000000)");
 }
 TEST_F(ExprFixture, ErrorLogNotPositive) {
     EXPECT_EQ(error("2+log(0)"),
@@ -198,7 +201,8 @@ TEST_F(ExprFixture, ErrorUnknownNamedParameter) {
     EXPECT_EQ(error("#NOSUCH.X"), "e.nc:3:1: unknown named parameter #NOSUCH.X");
 }
 TEST_F(ExprFixture, ErrorUnconfiguredSetting) {
-    EXPECT_EQ(error("#SAFEHEIGHT"), "e.nc:3:1: named parameter #SAFEHEIGHT is not configured on this machine");
+    EXPECT_EQ(error("#SAFEHEIGHT"),
+              "e.nc:3:1: named parameter #SAFEHEIGHT is not configured on this machine");
 }
 
 TEST(ToInteger, RoundsNearAndRejectsFractions) {

@@ -99,16 +99,19 @@ TEST_F(FlowFixture, ErrorG65WithoutP) {
     EXPECT_EQ(error("G65 L2"), "f.nc:4:1: G65 needs P (a program number or \"name\")");
 }
 TEST_F(FlowFixture, ErrorG65WithArguments) {
-    EXPECT_EQ(error("G65 P1 X5"), "f.nc:4:8: G65 takes only P and L; X is not allowed in a G65 block");
+    EXPECT_EQ(error("G65 P1 X5"),
+              "f.nc:4:8: G65 takes only P and L; X is not allowed in a G65 block");
 }
 TEST_F(FlowFixture, ErrorTwoCalls) {
-    EXPECT_EQ(error("G65 P1 M98"), "f.nc:4:8: G65 and M98 in one block: only one subprogram call per block");
+    EXPECT_EQ(error("G65 P1 M98"),
+              "f.nc:4:8: G65 and M98 in one block: only one subprogram call per block");
 }
 TEST_F(FlowFixture, ErrorM17AndM99) {
     EXPECT_EQ(error("M17 M99"), "f.nc:4:5: M17 and M99 in one block");
 }
 TEST_F(FlowFixture, ErrorCallAndReturn) {
-    EXPECT_EQ(error("G65 P1 M17"), "f.nc:4:8: a block cannot both call a subprogram and return from one");
+    EXPECT_EQ(error("G65 P1 M17"),
+              "f.nc:4:8: a block cannot both call a subprogram and return from one");
 }
 TEST_F(FlowFixture, ErrorNameWithoutCall) {
     EXPECT_EQ(error("G1 P\"x\""), "f.nc:4:4: P\"name\" is only meaningful with G65 or M98");

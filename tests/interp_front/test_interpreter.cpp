@@ -24,7 +24,9 @@ struct InterpFixture : ::testing::Test {
         interp->open(Source::from_string("main.nc", std::move(text)));
         return *interp;
     }
-    void run(std::string text, bool with_library = false) { start(std::move(text), with_library).run(); }
+    void run(std::string text, bool with_library = false) {
+        start(std::move(text), with_library).run();
+    }
     std::string run_error(std::string text, bool with_library = false) {
         try {
             run(std::move(text), with_library);
@@ -233,7 +235,8 @@ TEST_F(InterpFixture, ErrorRecursionTooDeep) {
 TEST_F(InterpFixture, ErrorM99TargetMissing) {
     EXPECT_EQ(run_error("G65 P7\nM30\nO7\nM99 P44\n"),
               "main.nc:4:1: M99 P44: no block N44 in the calling program");
-    EXPECT_EQ(run_error("G1 X1\nM99 P44\n"), "main.nc:2:1: M99 P44: no block N44 in the main program");
+    EXPECT_EQ(run_error("G1 X1\nM99 P44\n"),
+              "main.nc:2:1: M99 P44: no block N44 in the main program");
 }
 
 // S0 §4.2 custom M codes from public.dat (EX-26): M03 runs O203 after the block's motion; M05
@@ -250,12 +253,12 @@ TEST_F(InterpFixture, PublicDatCustomMCodes) {
         seen.push_back(s);
     }
     EXPECT_EQ(seen, (std::vector<std::string>{
-                        "main:G0 ",           // the block's motion first
-                        "lib:M901 H2 P1",      // O203
+                        "main:G0 ",        // the block's motion first
+                        "lib:M901 H2 P1",  // O203
                         "lib:G4 P5",
-                        "lib:M3 ",             // M03 inside O203 is the built-in code
+                        "lib:M3 ",  // M03 inside O203 is the built-in code
                         "main:M7 ",
-                        "lib:M901 H2 P0",      // O205, then O208 in written order
+                        "lib:M901 H2 P0",  // O205, then O208 in written order
                         "lib:G4 P5",
                         "lib:M901 H24 P1",
                         "lib:G4 P5",

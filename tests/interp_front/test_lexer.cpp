@@ -21,12 +21,24 @@ std::string shape(const std::vector<Token>& toks) {
     for (const Token& t : toks) {
         if (!s.empty()) s += ' ';
         switch (t.kind) {
-            case Tok::End: s += "E"; break;
-            case Tok::Word: s += "W:" + std::string(t.text); break;
-            case Tok::Number: s += "N:" + std::string(t.text); break;
-            case Tok::Var: s += "V:" + std::string(t.text); break;
-            case Tok::String: s += "S:" + std::string(t.text); break;
-            case Tok::Op: s += "O:" + std::string(op_text(t.op)); break;
+            case Tok::End:
+                s += "E";
+                break;
+            case Tok::Word:
+                s += "W:" + std::string(t.text);
+                break;
+            case Tok::Number:
+                s += "N:" + std::string(t.text);
+                break;
+            case Tok::Var:
+                s += "V:" + std::string(t.text);
+                break;
+            case Tok::String:
+                s += "S:" + std::string(t.text);
+                break;
+            case Tok::Op:
+                s += "O:" + std::string(op_text(t.op));
+                break;
         }
     }
     return s;
@@ -44,8 +56,7 @@ std::string lex_error(std::string_view line, const Dialect& d = ncstudio_dialect
 }  // namespace
 
 TEST(Lexer, PackedWords) {
-    EXPECT_EQ(shape(lex("N20G90G00X25Y30")),
-              "W:N N:20 W:G N:90 W:G N:00 W:X N:25 W:Y N:30 E");
+    EXPECT_EQ(shape(lex("N20G90G00X25Y30")), "W:N N:20 W:G N:90 W:G N:00 W:X N:25 W:Y N:30 E");
     EXPECT_EQ(shape(lex("G91G65 P9999")), "W:G N:91 W:G N:65 W:P N:9999 E");
 }
 
@@ -77,7 +88,8 @@ TEST(Lexer, CommentsAndBlockEnd) {
     EXPECT_EQ(shape(lex("B=1+2;")), "W:B O:= N:1 O:+ N:2 E");
     EXPECT_EQ(shape(lex("G918; ' clear latch flags")), "W:G N:918 E");
     // S1 prints the comment quote as U+2019.
-    EXPECT_EQ(shape(lex("G903 G01 X10 F600;\xE2\x80\x99 force")), "W:G N:903 W:G N:01 W:X N:10 W:F N:600 E");
+    EXPECT_EQ(shape(lex("G903 G01 X10 F600;\xE2\x80\x99 force")),
+              "W:G N:903 W:G N:01 W:X N:10 W:F N:600 E");
     EXPECT_EQ(shape(lex("G905 G01 X1\xE2\x80\x99 c")), "W:G N:905 W:G N:01 W:X N:1 E");
     // Parenthesised comments outside expressions (LEX-34), nested (LEX-31).
     EXPECT_EQ(shape(lex("(c(c) X100) Y100")), "W:Y N:100 E");
@@ -88,13 +100,15 @@ TEST(Lexer, ParenthesesAfterOperatorsAndFunctionsAreExpressions) {
     EXPECT_EQ(shape(lex("Z=5+sin(5+abs(-8))")),
               "W:Z O:= N:5 O:+ W:sin O:( N:5 O:+ W:abs O:( O:- N:8 O:) O:) E");
     EXPECT_EQ(shape(lex("IF(!#FC13)G90")), "W:IF O:( O:! V:FC13 O:) W:G N:90 E");
-    EXPECT_EQ(shape(lex("L=INT(ABS(#FC4-#FC3) /ABS (#FC5)) -1")),
-              "W:L O:= W:INT O:( W:ABS O:( V:FC4 O:- V:FC3 O:) O:/ W:ABS O:( V:FC5 O:) O:) O:- N:1 E");
+    EXPECT_EQ(
+        shape(lex("L=INT(ABS(#FC4-#FC3) /ABS (#FC5)) -1")),
+        "W:L O:= W:INT O:( W:ABS O:( V:FC4 O:- V:FC3 O:) O:/ W:ABS O:( V:FC5 O:) O:) O:- N:1 E");
 }
 
 TEST(Lexer, VariablesAndNamedParameters) {
     EXPECT_EQ(shape(lex("#1=30")), "V:1 O:= N:30 E");
-    EXPECT_EQ(shape(lex("X=#CURMACHPOS.X Y=#ctp_pos.y")), "W:X O:= V:CURMACHPOS.X W:Y O:= V:ctp_pos.y E");
+    EXPECT_EQ(shape(lex("X=#CURMACHPOS.X Y=#ctp_pos.y")),
+              "W:X O:= V:CURMACHPOS.X W:Y O:= V:ctp_pos.y E");
     // S0 §4.1.1 prints "#CTP_POS. X" with a space after the dot.
     auto t = lex("X=#CTP_POS. X Y1");
     EXPECT_EQ(shape(t), "W:X O:= V:CTP_POS. X W:Y N:1 E");
@@ -138,7 +152,8 @@ TEST(LexerErrors, NonAsciiOutsideComment) {
 }
 
 TEST(LexerErrors, UnterminatedString) {
-    EXPECT_EQ(lex_error("M801 MSG \"abc"), "t.nc:7:10: unterminated string (missing closing quote)");
+    EXPECT_EQ(lex_error("M801 MSG \"abc"),
+              "t.nc:7:10: unterminated string (missing closing quote)");
 }
 
 TEST(LexerErrors, UnclosedParenComment) {

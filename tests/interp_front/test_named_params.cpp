@@ -26,13 +26,13 @@ double read(std::string_view text, test::FakeMachine& m, const Dialect& d = ncst
 TEST(NamedParams, TableHasTheManualsFiftyEntriesInOrder) {
     const auto t = ncstudio_named_params();
     ASSERT_EQ(t.size(), 50u);
-    EXPECT_EQ(t[0].name, "CURMACHPOS.X");   // 01
-    EXPECT_EQ(t[6].name, "IMPORTMAP");      // 07
-    EXPECT_EQ(t[11].name, "UNIT.YR");       // 12
-    EXPECT_EQ(t[22].name, "BKREF_SW1.X");   // 23
-    EXPECT_EQ(t[43].name, "CALIBRATION_SW"); // 44
-    EXPECT_EQ(t[47].name, "FIXEDCYCLE_BACK"); // 48
-    EXPECT_EQ(t[49].name, "FIXEDCALI_REC"); // 50
+    EXPECT_EQ(t[0].name, "CURMACHPOS.X");      // 01
+    EXPECT_EQ(t[6].name, "IMPORTMAP");         // 07
+    EXPECT_EQ(t[11].name, "UNIT.YR");          // 12
+    EXPECT_EQ(t[22].name, "BKREF_SW1.X");      // 23
+    EXPECT_EQ(t[43].name, "CALIBRATION_SW");   // 44
+    EXPECT_EQ(t[47].name, "FIXEDCYCLE_BACK");  // 48
+    EXPECT_EQ(t[49].name, "FIXEDCALI_REC");    // 50
 }
 
 // Every entry resolves case-insensitively and reads its own value through MachineQuery.
@@ -52,12 +52,23 @@ TEST(NamedParams, EveryEntryReadsThroughMachineQuery) {
         for (char& c : lower) c = static_cast<char>(std::tolower(c));
         double expected = 0;
         switch (p.kind) {
-            case ParamKind::MachinePos: expected = m.machine_mm[p.index]; break;
-            case ParamKind::WorkPos: expected = m.work_mm[p.index]; break;
-            case ParamKind::InputMap: expected = 11; break;
-            case ParamKind::OutputMap: expected = 4; break;
-            case ParamKind::Setting: expected = (v += 1.0); break;
-            default: FAIL() << p.name;
+            case ParamKind::MachinePos:
+                expected = m.machine_mm[p.index];
+                break;
+            case ParamKind::WorkPos:
+                expected = m.work_mm[p.index];
+                break;
+            case ParamKind::InputMap:
+                expected = 11;
+                break;
+            case ParamKind::OutputMap:
+                expected = 4;
+                break;
+            case ParamKind::Setting:
+                expected = (v += 1.0);
+                break;
+            default:
+                FAIL() << p.name;
         }
         EXPECT_EQ(read(lower, m), expected) << p.name;
     }

@@ -222,14 +222,17 @@ TEST_F(ParserFixture, ErrorMsgWithoutString) {
     EXPECT_EQ(error("M801 MSG 5"), "p.nc:12:10: MSG must be followed by a \"string\"");
 }
 TEST_F(ParserFixture, ErrorTwoMessages) {
-    EXPECT_EQ(error("M801 MSG \"a\" \"b\""), "p.nc:12:14: a block can carry only one message string");
+    EXPECT_EQ(error("M801 MSG \"a\" \"b\""),
+              "p.nc:12:14: a block can carry only one message string");
 }
 TEST_F(ParserFixture, ErrorLabelNotAlone) {
-    EXPECT_EQ(error("O9001 G1 X1"), "p.nc:12:7: a subprogram label O… must stand alone on its line");
+    EXPECT_EQ(error("O9001 G1 X1"),
+              "p.nc:12:7: a subprogram label O… must stand alone on its line");
     EXPECT_EQ(error("G1 O9001"), "p.nc:12:4: a subprogram label O… must stand alone on its line");
 }
 TEST_F(ParserFixture, ErrorLabelSyntax) {
     EXPECT_EQ(error("O12.5"), "p.nc:12:1: O must be followed by a program number or a \"name\"");
-    EXPECT_EQ(error("O\"a b\""), "p.nc:12:2: subprogram name 'a b' may only contain letters, digits and '_'");
+    EXPECT_EQ(error("O\"a b\""),
+              "p.nc:12:2: subprogram name 'a b' may only contain letters, digits and '_'");
     EXPECT_EQ(error("O\"\""), "p.nc:12:2: empty subprogram name");
 }

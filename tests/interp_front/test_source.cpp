@@ -30,7 +30,8 @@ TEST(Source, SplitsLinesAndStripsCarriageReturns) {
 }
 
 TEST(Source, IndexesNumberedAndNamedLabels) {
-    auto s = Source::from_string("t.nc", "G0 X0\nM30\nO9001\nG1 X1\nM17\n  o\"Frame_1\" ' c\nM17\n");
+    auto s =
+        Source::from_string("t.nc", "G0 X0\nM30\nO9001\nG1 X1\nM17\n  o\"Frame_1\" ' c\nM17\n");
     ASSERT_TRUE(s->find_label(9001));
     EXPECT_EQ(s->find_label(9001)->pos.line, 3);
     ASSERT_TRUE(s->find_label("frame_1"));  // names are case-insensitive
@@ -58,8 +59,7 @@ TEST(Source, DuplicateNamedLabelIsAnError) {
         Source::from_string("dup.nc", "O\"a\"\nM17\nO\"A\"\nM17\n");
         FAIL() << "expected an error";
     } catch (const Error& e) {
-        EXPECT_STREQ(e.what(),
-                     "dup.nc:3:1: subprogram O\"A\" is defined twice (first at line 1)");
+        EXPECT_STREQ(e.what(), "dup.nc:3:1: subprogram O\"A\" is defined twice (first at line 1)");
     }
 }
 
@@ -68,8 +68,9 @@ TEST(Source, MissingFileNamesTheFile) {
         Source::open_file("/nonexistent/ifront/prog.nc");
         FAIL() << "expected an error";
     } catch (const Error& e) {
-        EXPECT_EQ(std::string(e.what()).rfind("/nonexistent/ifront/prog.nc:0:0: cannot open program", 0),
-                  0u)
+        EXPECT_EQ(
+            std::string(e.what()).rfind("/nonexistent/ifront/prog.nc:0:0: cannot open program", 0),
+            0u)
             << e.what();
     }
 }
@@ -82,9 +83,12 @@ TEST(Source, StreamsLargeFileAcrossWindowsAndSeeks) {
     {
         std::ofstream f(path, std::ios::binary);
         for (int i = 1; i <= 30000; ++i) {
-            if (i == 15000) f << long_line << "\n";
-            else if (i == 29000) f << "O777\n";
-            else f << "N" << i << " G1 X" << i << "\n";
+            if (i == 15000)
+                f << long_line << "\n";
+            else if (i == 29000)
+                f << "O777\n";
+            else
+                f << "N" << i << " G1 X" << i << "\n";
         }
     }
     auto s = Source::open_file(path);

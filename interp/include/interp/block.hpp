@@ -33,7 +33,7 @@ struct SourceLoc {
 // Every diagnostic of the interpreter. what() is "file:line:col: reason". Thrown only in the
 // configuration world (the interpreter thread), never on a realtime path.
 class Error : public std::runtime_error {
-public:
+  public:
     Error(const SourceLoc& loc, const std::string& reason)
         : std::runtime_error(format(loc, reason)),
           file_(loc.file),
@@ -46,7 +46,7 @@ public:
     int col() const { return col_; }
     const std::string& reason() const { return reason_; }
 
-private:
+  private:
     static std::string format(const SourceLoc& loc, const std::string& reason) {
         return std::string(loc.file) + ":" + std::to_string(loc.line) + ":" +
                std::to_string(loc.col) + ": " + reason;
@@ -59,10 +59,14 @@ private:
 
 // G codes are stored as integers scaled by ten so that decimal codes need no floating compare:
 // G0 -> 0, G1 -> 10, G50.1 -> 501, G54.1 -> 541, G992 -> 9920.
-constexpr int gcode(int whole, int tenth = 0) { return whole * 10 + tenth; }
+constexpr int gcode(int whole, int tenth = 0) {
+    return whole * 10 + tenth;
+}
 
 // Index of an address letter in Block::words: 'A' -> 0 … 'Z' -> 25.
-constexpr int letter_index(char c) { return (c >= 'a' && c <= 'z') ? c - 'a' : c - 'A'; }
+constexpr int letter_index(char c) {
+    return (c >= 'a' && c <= 'z') ? c - 'a' : c - 'A';
+}
 
 // NcStudio multi-letter keywords of the extended codes (G904, G906, G916, M901; S0 §3.9–3.10).
 // Index 0/1/2 of the per-axis arrays is X/Y/Z.
@@ -86,25 +90,42 @@ struct NcKeywords {
 struct Block {
     static constexpr int kMaxCodes = 16;
 
-    SourceLoc loc;                      // the block's first character
-    std::optional<std::int64_t> n;      // sequence number N
-    StaticVec<int, kMaxCodes> g;        // G codes, scaled x10 (see gcode()), in written order
-    StaticVec<int, kMaxCodes> g_col;    // column of each entry of g
-    StaticVec<int, kMaxCodes> m;        // M codes in written order
-    StaticVec<int, kMaxCodes> m_col;    // column of each entry of m
+    SourceLoc loc;                    // the block's first character
+    std::optional<std::int64_t> n;    // sequence number N
+    StaticVec<int, kMaxCodes> g;      // G codes, scaled x10 (see gcode()), in written order
+    StaticVec<int, kMaxCodes> g_col;  // column of each entry of g
+    StaticVec<int, kMaxCodes> m;      // M codes in written order
+    StaticVec<int, kMaxCodes> m_col;  // column of each entry of m
     std::array<std::optional<double>, 26> words;  // address letters A..Z except G, M, N, O
-    std::array<int, 26> word_col{};     // column of each present word (0 when absent)
+    std::array<int, 26> word_col{};  // column of each present word; read it through col()
     // Bit i set: letter 'A'+i was written as a plain integer literal without a decimal point
     // (ISO standard-notation scaling needs to know; LEX-52).
     std::uint32_t integer_literal_mask = 0;
-    std::optional<std::string> msg;     // M801 MSG "text" (V5.4: M801 "text")
-    NcKeywords kw;                      // PLC, LEVEL, FX.., PX.., LX..
+    std::optional<std::string> msg;  // M801 MSG "text" (V5.4: M801 "text")
+    NcKeywords kw;                   // PLC, LEVEL, FX.., PX.., LX..
+
+    // Back to an empty block, cheaper than assigning Block{} (only the used parts are reset).
+    void clear() {
+        loc = SourceLoc{};
+        n.reset();
+        g.clear();
+        g_col.clear();
+        m.clear();
+        m_col.clear();
+        for (auto& w : words) w.reset();
+        integer_literal_mask = 0;
+        msg.reset();
+        kw = NcKeywords{};
+    }
 
     bool has(char letter) const { return words[letter_index(letter)].has_value(); }
     // The value of a present word; call has() first (throws std::bad_optional_access otherwise).
     double get(char letter) const { return words[letter_index(letter)].value(); }
     std::optional<double> opt(char letter) const { return words[letter_index(letter)]; }
-    int col(char letter) const { return word_col[letter_index(letter)]; }
+    int col(char letter) const {
+        const int i = letter_index(letter);
+        return words[i] ? word_col[i] : 0;
+    }
     SourceLoc loc_of(char letter) const {
         int c = col(letter);
         return SourceLoc{loc.file, loc.line, c != 0 ? c : loc.col};
@@ -126,7 +147,7 @@ struct Block {
 // variable assignments too). M02/M30 blocks are passed on like any other block; the front end
 // stops reading after them.
 class BlockExecutor {
-public:
+  public:
     virtual ~BlockExecutor() = default;
     virtual void execute(const Block& block) = 0;
     // The program ended by running off the end of the main file without M02/M30. `loc` is the
@@ -142,7 +163,7 @@ constexpr int kMachineAxes = 6;
 // end answers from its own model; on a machine, the live values wait until motion has caught up
 // (NcStudio's G906 semantics), so the front end may call them at any time.
 class MachineQuery {
-public:
+  public:
     virtual ~MachineQuery() = default;
     // Live state. Linear axes in mm, rotary axes in degrees.
     virtual double machine_pos_mm(Axis axis) = 0;

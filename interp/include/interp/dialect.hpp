@@ -53,8 +53,8 @@ struct Dialect {
     int sub_end_m = 17;                // M17 ends a subprogram; M99 too (C-07)
     // Decodes M98's P (and optional L) into program and count. Throws Error at `loc` on a
     // malformed pair.
-    CallSpec (*decode_m98)(std::int64_t p, std::optional<std::int64_t> l, const SourceLoc& loc) =
-        nullptr;
+    CallSpec (*decode_m98)(std::int64_t p, std::optional<std::int64_t> l,
+                           const SourceLoc& loc) = nullptr;
 };
 
 // NcStudio 6th edition (S0), the default.

@@ -39,12 +39,12 @@ struct TokenCursor {
 // What a '#' operand refers to, resolved from its text.
 struct VarRef {
     enum class Kind { Numbered, FixedCycle, Named } kind = Kind::Numbered;
-    int index = 0;         // n of #n or #FCn
-    std::string_view text; // as written, for messages
+    int index = 0;          // n of #n or #FCn
+    std::string_view text;  // as written, for messages
 };
 
 class ExprEvaluator {
-public:
+  public:
     // `file` and `line` locate errors; columns come from the tokens.
     ExprEvaluator(const Dialect& dialect, Variables& vars, MachineQuery& machine,
                   std::string_view file, int line)
@@ -61,7 +61,7 @@ public:
 
     SourceLoc loc(const Token& t) const { return SourceLoc{file_, line_, t.col}; }
 
-private:
+  private:
     double parse_binary(TokenCursor& cur, int min_level);
     double parse_unary(TokenCursor& cur);
     double parse_primary(TokenCursor& cur);

@@ -41,14 +41,24 @@ std::string program_label(std::int64_t number, const std::optional<std::string>&
 
 // One active (or queued) subprogram run.
 struct CallFrame {
-    Source* source = nullptr;    // where the subprogram is defined
-    SourcePos body;              // its first line after the label
+    Source* source = nullptr;  // where the subprogram is defined
+    SourcePos body;            // its first line after the label
     Source* return_source = nullptr;
     SourcePos return_pos;        // the line after the calling block
     std::int64_t remaining = 1;  // runs left, including the current one
     std::string label;           // "O9001", for messages
-    int custom_code = -1;        // public.dat code it implements: M n -> n, G n -> 1000 + n
+    int custom_code = -1;        // public.dat code it implements (see kCustomGFlag)
     bool started = false;        // queued frames (several custom codes in one block) wait
+};
+
+// CallFrame::custom_code of public.dat custom code G n is kCustomGFlag + n; of M n it is n.
+constexpr int kCustomGFlag = 1000;
+
+// A public.dat call produced by a custom M or G code of a block, queued behind the block.
+struct CustomCall {
+    int code = 0;  // M n -> n, G n -> kCustomGFlag + n
+    std::int64_t program = 0;
+    LabelSite site;
 };
 
 }  // namespace interp

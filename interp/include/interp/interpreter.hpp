@@ -12,6 +12,7 @@
 //   M n / G n (n ≤ 99)         run O(200+n) / O(600+n) when public.dat defines it
 //   M02 / M30                  passed on to the executor, then the program ends
 // Subprograms are looked up in the calling file, then the main file, then public.dat.
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -37,7 +38,7 @@ struct InterpreterOptions {
 };
 
 class Interpreter {
-public:
+  public:
     Interpreter(BlockExecutor& executor, MachineQuery& machine, InterpreterOptions options = {});
     ~Interpreter();
     Interpreter(const Interpreter&) = delete;
@@ -64,8 +65,18 @@ public:
     Variables& variables() { return vars_; }
     const Dialect& dialect() const { return *options_.dialect; }
 
-private:
+  private:
     void execute_line(const SourceLoc& loc);
+    void handle_label(const SourceLoc& loc);
+    std::optional<CallFrame> resolve_call(const CallRequest& call);
+    bool custom_code_active(int code) const;
+    void collect_custom_codes(Block& b, bool has_call);
+    void take_fixed_cycle_args(Block& b);
+    void set_fixed_cycle_vars(const SourceLoc& loc);
+    void handle_return(const ReturnRequest& r, const SourcePos& after_call);
+    void return_in_main(const ReturnRequest& r, const SourcePos& after_call);
+    void return_to_sequence(const ReturnRequest& r, const SourcePos& after_call);
+    void push_calls(std::optional<CallFrame>& call_frame, const SourcePos& after_call);
     void end_program(const SourceLoc& loc);
     // Starts (or repeats) a subprogram run: positions at the line after its label.
     void enter(CallFrame& frame);
@@ -81,9 +92,12 @@ private:
     std::unique_ptr<Source> main_;
     std::unique_ptr<Source> library_;
     std::vector<CallFrame> stack_;
+    std::vector<CustomCall> customs_;                  // custom codes of the current block
+    std::array<std::optional<double>, 51> fc_args_{};  // #FC arguments of a custom G code
     Source* current_ = nullptr;
     bool finished_ = true;
-    bool main_started_ = false;  // a block of the main program has run (a leading O label is a name)
+    bool main_started_ =
+        false;  // a block of the main program has run (a leading O label is a name)
 };
 
 }  // namespace interp

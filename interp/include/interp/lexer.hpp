@@ -31,17 +31,17 @@ enum class Op : std::uint8_t {
     Star,
     Slash,
     Caret,
-    Not,       // !
-    Assign,    // =
-    EqEq,      // ==
-    NotEq,     // !=
-    Less,      // <
-    Greater,   // >
-    LessEq,    // <=
-    GreaterEq, // >=
-    AndAnd,    // &&
-    OrOr,      // ||
-    Bar,       // | (V5.4 absolute-value bars)
+    Not,        // !
+    Assign,     // =
+    EqEq,       // ==
+    NotEq,      // !=
+    Less,       // <
+    Greater,    // >
+    LessEq,     // <=
+    GreaterEq,  // >=
+    AndAnd,     // &&
+    OrOr,       // ||
+    Bar,        // | (V5.4 absolute-value bars)
     LParen,
     RParen,
     LBracket,
@@ -63,7 +63,7 @@ struct Token {
 std::string_view op_text(Op op);
 
 class Lexer {
-public:
+  public:
     explicit Lexer(const Dialect& dialect) : dialect_(&dialect) {}
 
     // Lexes `line` into `out` (cleared first; the last token is always Tok::End). `loc` gives
@@ -72,7 +72,7 @@ public:
     void lex(std::string_view line, const SourceLoc& loc, std::vector<Token>& out,
              bool expression_start = false) const;
 
-private:
+  private:
     const Dialect* dialect_;
 };
 

@@ -12,14 +12,14 @@
 namespace interp {
 
 enum class ParamKind {
-    MachinePos,   // index = axis
-    WorkPos,      // index = axis
-    InputMap,     // all input ports as a bit map
-    OutputMap,    // all output ports as a bit map
-    InputBit,     // index = port
-    OutputBit,    // index = port
+    MachinePos,  // index = axis
+    WorkPos,     // index = axis
+    InputMap,    // all input ports as a bit map
+    OutputMap,   // all output ports as a bit map
+    InputBit,    // index = port
+    OutputBit,   // index = port
     SpindleRpm,
-    Setting,      // a machine setting, asked for by name
+    Setting,  // a machine setting, asked for by name
 };
 
 struct NamedParam {

@@ -33,14 +33,14 @@ struct ParsedLine {
 };
 
 class BlockParser {
-public:
+  public:
     BlockParser(const Dialect& dialect, Variables& vars, MachineQuery& machine)
         : dialect_(&dialect), lexer_(dialect), vars_(vars), machine_(machine) {}
 
     // Throws Error (file:line:col) on any syntax or evaluation error. `out` is reset first.
     void parse(std::string_view line, const SourceLoc& loc, ParsedLine& out);
 
-private:
+  private:
     struct Ctx;
     void parse_word(Ctx& c);
     void parse_letter(Ctx& c, const Token& letter);

@@ -29,7 +29,7 @@ struct LabelSite {
 };
 
 class Source {
-public:
+  public:
     // Opens a file for streaming. Throws Error naming the file when it cannot be read.
     static std::unique_ptr<Source> open_file(const std::string& path);
     // Wraps program text held in memory (MDI, tests); `name` is used in diagnostics.
@@ -57,15 +57,15 @@ public:
     std::optional<LabelSite> find_label(std::string_view name) const;
     std::size_t label_count() const { return numbered_.size() + named_.size(); }
 
-private:
+  private:
     Source(std::string name, std::FILE* file, std::string text);
     void index_labels();
     void index_line(std::string_view line, SourcePos pos);
     bool fill();
 
     std::string name_;
-    std::FILE* file_ = nullptr;  // null for in-memory text
-    std::string text_;           // in-memory text, or the read window of a file
+    std::FILE* file_ = nullptr;        // null for in-memory text
+    std::string text_;                 // in-memory text, or the read window of a file
     std::uint64_t window_offset_ = 0;  // file offset of text_[0] (always 0 for in-memory text)
     std::size_t window_pos_ = 0;       // next unread byte in text_
     bool eof_ = false;

@@ -9,7 +9,7 @@ namespace interp {
 
 template <typename T, std::size_t N>
 class StaticVec {
-public:
+  public:
     StaticVec() = default;
     StaticVec(std::initializer_list<T> init) {
         for (const T& v : init) push_back(v);
@@ -64,8 +64,8 @@ public:
         return true;
     }
 
-private:
-    std::array<T, N> items_{};
+  private:
+    std::array<T, N> items_;  // not zeroed: only [0, size_) is ever read
     std::size_t size_ = 0;
 };
 

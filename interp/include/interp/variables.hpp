@@ -12,7 +12,7 @@
 namespace interp {
 
 class Variables {
-public:
+  public:
     static constexpr int kMaxNumbered = 999;
     static constexpr int kMaxFixedCycle = 50;
 
@@ -33,7 +33,7 @@ public:
     // Forget every value (program start).
     void clear();
 
-private:
+  private:
     struct Undo {
         bool fixed_cycle;
         int index;

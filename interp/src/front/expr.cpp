@@ -23,9 +23,9 @@ struct FnEntry {
 
 // S0 §3.11.2 and S1 §3.5 (both editions have the same twelve functions).
 constexpr FnEntry kFunctions[] = {
-    {"SIN", Fn::Sin},   {"COS", Fn::Cos},   {"TG", Fn::Tg},     {"CTG", Fn::Ctg},
-    {"ASIN", Fn::Asin}, {"ACOS", Fn::Acos}, {"ATG", Fn::Atg},   {"EXP", Fn::Exp},
-    {"SQRT", Fn::Sqrt}, {"LOG", Fn::Log},   {"INT", Fn::Int},   {"ABS", Fn::Abs},
+    {"SIN", Fn::Sin},   {"COS", Fn::Cos},   {"TG", Fn::Tg},   {"CTG", Fn::Ctg},
+    {"ASIN", Fn::Asin}, {"ACOS", Fn::Acos}, {"ATG", Fn::Atg}, {"EXP", Fn::Exp},
+    {"SQRT", Fn::Sqrt}, {"LOG", Fn::Log},   {"INT", Fn::Int}, {"ABS", Fn::Abs},
 };
 
 const FnEntry* find_function(std::string_view name) {
@@ -37,24 +37,41 @@ const FnEntry* find_function(std::string_view name) {
 BinOp to_binop(Op op, bool& ok) {
     ok = true;
     switch (op) {
-        case Op::OrOr: return BinOp::Or;
-        case Op::AndAnd: return BinOp::And;
-        case Op::EqEq: return BinOp::Eq;
-        case Op::NotEq: return BinOp::Ne;
-        case Op::Greater: return BinOp::Gt;
-        case Op::Less: return BinOp::Lt;
-        case Op::GreaterEq: return BinOp::Ge;
-        case Op::LessEq: return BinOp::Le;
-        case Op::Plus: return BinOp::Add;
-        case Op::Minus: return BinOp::Sub;
-        case Op::Star: return BinOp::Mul;
-        case Op::Slash: return BinOp::Div;
-        case Op::Caret: return BinOp::Pow;
-        default: ok = false; return BinOp::Add;
+        case Op::OrOr:
+            return BinOp::Or;
+        case Op::AndAnd:
+            return BinOp::And;
+        case Op::EqEq:
+            return BinOp::Eq;
+        case Op::NotEq:
+            return BinOp::Ne;
+        case Op::Greater:
+            return BinOp::Gt;
+        case Op::Less:
+            return BinOp::Lt;
+        case Op::GreaterEq:
+            return BinOp::Ge;
+        case Op::LessEq:
+            return BinOp::Le;
+        case Op::Plus:
+            return BinOp::Add;
+        case Op::Minus:
+            return BinOp::Sub;
+        case Op::Star:
+            return BinOp::Mul;
+        case Op::Slash:
+            return BinOp::Div;
+        case Op::Caret:
+            return BinOp::Pow;
+        default:
+            ok = false;
+            return BinOp::Add;
     }
 }
 
-double truth(bool b) { return b ? 1.0 : 0.0; }
+double truth(bool b) {
+    return b ? 1.0 : 0.0;
+}
 
 }  // namespace
 
@@ -107,8 +124,10 @@ double ExprEvaluator::read(const Token& var) {
     const VarRef ref = resolve(var);
     if (dry_) return 0.0;
     switch (ref.kind) {
-        case VarRef::Kind::Numbered: return vars_.numbered(ref.index, loc(var));
-        case VarRef::Kind::FixedCycle: return vars_.fixed_cycle(ref.index, loc(var));
+        case VarRef::Kind::Numbered:
+            return vars_.numbered(ref.index, loc(var));
+        case VarRef::Kind::FixedCycle:
+            return vars_.fixed_cycle(ref.index, loc(var));
         case VarRef::Kind::Named: {
             const auto p = find_named_param(ref.text, d_);
             return read_named_param(*p, machine_, loc(var));
@@ -153,9 +172,8 @@ double ExprEvaluator::parse_binary(TokenCursor& cur, int min_level) {
         if (t.space_before && depth_ == 0 && !d_.tolerant_expr_spaces) return lhs;
         const BinOpRule* rule = binary_rule(t);
         if (rule == nullptr) {
-            if (t.kind == Tok::Op && (t.op == Op::EqEq || t.op == Op::NotEq ||
-                                      t.op == Op::AndAnd || t.op == Op::OrOr ||
-                                      t.op == Op::Caret)) {
+            if (t.kind == Tok::Op && (t.op == Op::EqEq || t.op == Op::NotEq || t.op == Op::AndAnd ||
+                                      t.op == Op::OrOr || t.op == Op::Caret)) {
                 throw Error(loc(t), "operator '" + std::string(op_text(t.op)) +
                                         "' is not available in dialect " + std::string(d_.name));
             }
@@ -166,22 +184,46 @@ double ExprEvaluator::parse_binary(TokenCursor& cur, int min_level) {
         const Token& op_tok = cur.next();
         const double rhs = parse_binary(cur, rule->right_assoc ? rule->level : rule->level + 1);
         switch (rule->op) {
-            case BinOp::Or: lhs = truth(lhs != 0.0 || rhs != 0.0); break;
-            case BinOp::And: lhs = truth(lhs != 0.0 && rhs != 0.0); break;
-            case BinOp::Eq: lhs = truth(std::fabs(lhs - rhs) <= kEqualTolerance); break;
-            case BinOp::Ne: lhs = truth(std::fabs(lhs - rhs) > kEqualTolerance); break;
-            case BinOp::Gt: lhs = truth(lhs > rhs); break;
-            case BinOp::Lt: lhs = truth(lhs < rhs); break;
-            case BinOp::Ge: lhs = truth(lhs >= rhs); break;
-            case BinOp::Le: lhs = truth(lhs <= rhs); break;
-            case BinOp::Add: lhs = checked(lhs + rhs, op_tok, "addition"); break;
-            case BinOp::Sub: lhs = checked(lhs - rhs, op_tok, "subtraction"); break;
-            case BinOp::Mul: lhs = checked(lhs * rhs, op_tok, "multiplication"); break;
+            case BinOp::Or:
+                lhs = truth(lhs != 0.0 || rhs != 0.0);
+                break;
+            case BinOp::And:
+                lhs = truth(lhs != 0.0 && rhs != 0.0);
+                break;
+            case BinOp::Eq:
+                lhs = truth(std::fabs(lhs - rhs) <= kEqualTolerance);
+                break;
+            case BinOp::Ne:
+                lhs = truth(std::fabs(lhs - rhs) > kEqualTolerance);
+                break;
+            case BinOp::Gt:
+                lhs = truth(lhs > rhs);
+                break;
+            case BinOp::Lt:
+                lhs = truth(lhs < rhs);
+                break;
+            case BinOp::Ge:
+                lhs = truth(lhs >= rhs);
+                break;
+            case BinOp::Le:
+                lhs = truth(lhs <= rhs);
+                break;
+            case BinOp::Add:
+                lhs = checked(lhs + rhs, op_tok, "addition");
+                break;
+            case BinOp::Sub:
+                lhs = checked(lhs - rhs, op_tok, "subtraction");
+                break;
+            case BinOp::Mul:
+                lhs = checked(lhs * rhs, op_tok, "multiplication");
+                break;
             case BinOp::Div:
                 if (rhs == 0.0 && !dry_) throw Error(loc(op_tok), "division by zero");
                 lhs = rhs == 0.0 ? 0.0 : checked(lhs / rhs, op_tok, "division");
                 break;
-            case BinOp::Pow: lhs = checked(std::pow(lhs, rhs), op_tok, "power"); break;
+            case BinOp::Pow:
+                lhs = checked(std::pow(lhs, rhs), op_tok, "power");
+                break;
         }
     }
 }
@@ -203,9 +245,12 @@ double ExprEvaluator::parse_unary(TokenCursor& cur) {
 double ExprEvaluator::parse_primary(TokenCursor& cur) {
     const Token& t = cur.next();
     switch (t.kind) {
-        case Tok::Number: return t.number;
-        case Tok::Var: return read(t);
-        case Tok::Word: return call_function(t, cur);
+        case Tok::Number:
+            return t.number;
+        case Tok::Var:
+            return read(t);
+        case Tok::Word:
+            return call_function(t, cur);
         case Tok::Op:
             if (t.op == Op::LParen || (t.op == Op::Bar && d_.abs_bars)) {
                 const Op close = t.op == Op::LParen ? Op::RParen : Op::Bar;
@@ -225,7 +270,8 @@ double ExprEvaluator::parse_primary(TokenCursor& cur) {
             break;
         case Tok::End:
             throw Error(loc(t), "expression is incomplete at end of block");
-        case Tok::String: break;
+        case Tok::String:
+            break;
     }
     throw Error(loc(t), "unexpected '" + std::string(t.text) + "' in expression");
 }
@@ -246,13 +292,16 @@ double ExprEvaluator::call_function(const Token& name, TokenCursor& cur) {
     }
     if (dry_) return 0.0;
     auto domain = [&](const char* why) {
-        return Error(loc(name), std::string(name.text) + ": " + why + " (argument " +
-                                    std::to_string(x) + ")");
+        return Error(loc(name),
+                     std::string(name.text) + ": " + why + " (argument " + std::to_string(x) + ")");
     };
     switch (fn->fn) {
-        case Fn::Sin: return std::sin(x);
-        case Fn::Cos: return std::cos(x);
-        case Fn::Tg: return checked(std::tan(x), name, "tg");
+        case Fn::Sin:
+            return std::sin(x);
+        case Fn::Cos:
+            return std::cos(x);
+        case Fn::Tg:
+            return checked(std::tan(x), name, "tg");
         case Fn::Ctg: {
             const double tn = std::tan(x);
             if (tn == 0.0) throw domain("cotangent is undefined");
@@ -264,16 +313,20 @@ double ExprEvaluator::call_function(const Token& name, TokenCursor& cur) {
         case Fn::Acos:
             if (x < -1.0 || x > 1.0) throw domain("argument outside [-1, 1]");
             return std::acos(x);
-        case Fn::Atg: return std::atan(x);
-        case Fn::Exp: return checked(std::exp(x), name, "exp");
+        case Fn::Atg:
+            return std::atan(x);
+        case Fn::Exp:
+            return checked(std::exp(x), name, "exp");
         case Fn::Sqrt:
             if (x < 0.0) throw domain("square root of a negative number");
             return std::sqrt(x);
         case Fn::Log:
             if (x <= 0.0) throw domain("logarithm of a number that is not positive");
             return std::log(x);
-        case Fn::Int: return std::floor(x);
-        case Fn::Abs: return std::fabs(x);
+        case Fn::Int:
+            return std::floor(x);
+        case Fn::Abs:
+            return std::fabs(x);
     }
     return 0.0;
 }

@@ -9,23 +9,13 @@ namespace interp {
 
 namespace {
 
-constexpr int kCustomGFlag = 1000;  // CallFrame::custom_code of G n is 1000 + n
-
 // Fixed-cycle variables a custom G code receives (FC-1): X Y Z R Q P F, K or L.
 struct FcWord {
     char letter;
     int fc;
 };
-constexpr FcWord kFcWords[] = {{'X', 1}, {'Y', 2}, {'Z', 3}, {'R', 4}, {'Q', 5},
+constexpr FcWord kFcWords[] = {{'X', 1}, {'Y', 2}, {'Z', 3},  {'R', 4}, {'Q', 5},
                                {'P', 6}, {'F', 7}, {'K', 11}, {'L', 11}};
-
-// A queued public.dat call produced by a custom code in the block.
-struct CustomCall {
-    int code;  // M n -> n, G n -> 1000 + n
-    std::int64_t program;
-    LabelSite site;
-    int col;
-};
 
 bool starts_with_slash(std::string_view line) {
     for (char c : line) {
@@ -85,11 +75,17 @@ Interpreter::Interpreter(BlockExecutor& executor, MachineQuery& machine, Interpr
 
 Interpreter::~Interpreter() = default;
 
-void Interpreter::load_library(const std::string& path) { library_ = Source::open_file(path); }
+void Interpreter::load_library(const std::string& path) {
+    library_ = Source::open_file(path);
+}
 
-void Interpreter::set_library(std::unique_ptr<Source> library) { library_ = std::move(library); }
+void Interpreter::set_library(std::unique_ptr<Source> library) {
+    library_ = std::move(library);
+}
 
-void Interpreter::open(const std::string& path) { open(Source::open_file(path)); }
+void Interpreter::open(const std::string& path) {
+    open(Source::open_file(path));
+}
 
 void Interpreter::open(std::unique_ptr<Source> program) {
     main_ = std::move(program);
@@ -142,16 +138,8 @@ void Interpreter::end_program(const SourceLoc& loc) {
 void Interpreter::execute_line(const SourceLoc& loc) {
     ParsedLine& line = parsed_;
     if (line.is_label) {
-        if (stack_.empty()) {
-            // A label before any block names the main program; after blocks it is the first
-            // subprogram, which the main program must not run into (S0 §3.12 ex. 5).
-            if (main_started_) end_program(loc);
-            return;
-        }
-        const std::string label = stack_.back().label;
-        finished_ = true;
-        stack_.clear();
-        throw Error(loc, "subprogram " + label + " runs into the next label without M17");
+        handle_label(loc);
+        return;
     }
     if (stack_.empty()) main_started_ = true;
 
@@ -160,91 +148,18 @@ void Interpreter::execute_line(const SourceLoc& loc) {
 
     // Resolve everything that can fail before the block runs: a rejected block changes nothing.
     std::optional<CallFrame> call_frame;
-    if (flow.call) {
-        const CallRequest& c = *flow.call;
-        const std::string label = program_label(c.program, c.name);
-        Source* found_in = nullptr;
-        std::optional<LabelSite> site;
-        for (Source* s : {current_, main_.get(), library_.get()}) {
-            if (s == nullptr) continue;
-            site = c.name ? s->find_label(*c.name) : s->find_label(c.program);
-            if (site) {
-                found_in = s;
-                break;
-            }
-        }
-        if (!site) throw Error(c.loc, "subprogram " + label + " not found");
-        if (c.count > 0) {
-            CallFrame f;
-            f.source = found_in;
-            f.body = SourcePos{site->pos.offset, site->pos.line};
-            f.remaining = c.count;
-            f.label = label;
-            call_frame = f;
-        }
-    }
-
-    StaticVec<CustomCall, Block::kMaxCodes> customs;
-    const Dialect& d = *options_.dialect;
-    auto active = [&](int code) {
-        for (const CallFrame& f : stack_)
-            if (f.custom_code == code) return true;
-        return false;
-    };
-    if (library_) {
-        for (std::size_t i = 0; i < b.m.size();) {
-            const int m = b.m[i];
-            std::optional<LabelSite> site;
-            if (m <= d.custom_code_max && !active(m)) site = library_->find_label(d.custom_m_base + m);
-            if (site) {
-                customs.push_back(CustomCall{m, d.custom_m_base + m, *site, b.m_col[i]});
-                b.m.erase_at(i);
-                b.m_col.erase_at(i);
-            } else {
-                ++i;
-            }
-        }
-        for (std::size_t i = 0; i < b.g.size();) {
-            const int g = b.g[i];
-            std::optional<LabelSite> site;
-            if (g % 10 == 0 && g / 10 <= d.custom_code_max && !active(kCustomGFlag + g / 10))
-                site = library_->find_label(d.custom_g_base + g / 10);
-            if (site) {
-                if (flow.call) {
-                    throw Error(SourceLoc{b.loc.file, b.loc.line, b.g_col[i]},
-                                "custom G" + std::to_string(g / 10) +
-                                    " and a subprogram call in one block");
-                }
-                customs.push_back(
-                    CustomCall{kCustomGFlag + g / 10, d.custom_g_base + g / 10, *site, b.g_col[i]});
-                b.g.erase_at(i);
-                b.g_col.erase_at(i);
-            } else {
-                ++i;
-            }
-        }
-    }
+    if (flow.call) call_frame = resolve_call(*flow.call);
+    customs_.clear();
+    if (library_) collect_custom_codes(b, flow.call.has_value());
     bool custom_g = false;
-    for (const CustomCall& cc : customs) custom_g = custom_g || cc.code >= kCustomGFlag;
-    // A custom G code takes the block's address words as its arguments (#FC…); the other G and M
-    // codes act first, as for ISO G macros (CUS-5, MACG-2).
-    std::array<std::optional<double>, 51> fc_args{};
-    if (custom_g) {
-        for (const FcWord& w : kFcWords) {
-            const int i = letter_index(w.letter);
-            if (b.words[i]) {
-                fc_args[w.fc] = b.words[i];
-                b.words[i].reset();
-                b.word_col[i] = 0;
-            }
-        }
-    }
-
-    const std::size_t new_frames = (call_frame ? 1 : 0) + customs.size();
+    for (const CustomCall& cc : customs_) custom_g = custom_g || cc.code >= kCustomGFlag;
+    if (custom_g) take_fixed_cycle_args(b);
+    const Dialect& d = *options_.dialect;
+    const std::size_t new_frames = (call_frame ? 1 : 0) + customs_.size();
     if (stack_.size() + new_frames > static_cast<std::size_t>(d.max_call_depth)) {
-        throw Error(flow.call ? flow.call->loc : loc,
-                    "subprogram calls nested deeper than " + std::to_string(d.max_call_depth) +
-                        " levels");
+        throw Error(
+            flow.call ? flow.call->loc : loc,
+            "subprogram calls nested deeper than " + std::to_string(d.max_call_depth) + " levels");
     }
 
     if (!b.empty()) executor_.execute(b);
@@ -253,94 +168,189 @@ void Interpreter::execute_line(const SourceLoc& loc) {
         stack_.clear();
         return;
     }
-
-    if (custom_g) {
-        for (int fc = 1; fc <= 50; ++fc)
-            if (fc_args[fc]) vars_.set_fixed_cycle(fc, *fc_args[fc], loc);
-        vars_.set_fixed_cycle(12, machine_.cycle_return_to_r() ? 1.0 : 0.0, loc);
-        vars_.set_fixed_cycle(13, machine_.incremental_mode() ? 1.0 : 0.0, loc);
-        vars_.set_fixed_cycle(14, machine_.work_pos_mm(Axis::Z) / machine_.mm_per_program_unit(),
-                              loc);
-    }
+    if (custom_g) set_fixed_cycle_vars(loc);
 
     const SourcePos after_call = current_->tell();
     if (flow.ret) {
-        const ReturnRequest& r = *flow.ret;
-        if (stack_.empty()) {
-            if (r.m != 99) throw Error(r.loc, "M" + std::to_string(r.m) + " outside a subprogram");
-            if (!options_.main_m99_loops) {
-                end_program(r.loc);
-                return;
-            }
-            // S0 §3.4: M99 in the main program returns to its start (or to N n, SUB-8).
-            SourcePos target{};
-            if (r.sequence) {
-                const auto at = find_sequence(*main_, SourcePos{}, *r.sequence, std::nullopt);
-                if (!at) {
-                    main_->seek(after_call);
-                    throw Error(r.loc, "M99 P" + std::to_string(*r.sequence) +
-                                           ": no block N" + std::to_string(*r.sequence) +
-                                           " in the main program");
-                }
-                target = *at;
-            }
-            main_->seek(target);
-            main_started_ = false;
-            return;
-        }
-        CallFrame& top = stack_.back();
-        if (r.sequence) {
-            // SUB-7: return to the caller at N n, searching forward from the call, then from the
-            // start of the calling program.
-            const CallFrame done = top;
-            stack_.pop_back();
-            Source& caller = *done.return_source;
-            const SourcePos caller_start = stack_.empty() ? SourcePos{} : stack_.back().body;
-            std::optional<SourcePos> at =
-                find_sequence(caller, done.return_pos, *r.sequence, std::nullopt);
-            if (!at) at = find_sequence(caller, caller_start, *r.sequence, done.return_pos.offset);
-            if (!at) {
-                stack_.push_back(done);
-                current_->seek(after_call);
-                throw Error(r.loc, "M99 P" + std::to_string(*r.sequence) + ": no block N" +
-                                       std::to_string(*r.sequence) + " in the calling program");
-            }
-            // Queued calls of the same block are dropped: control left that block for good.
-            while (!stack_.empty() && !stack_.back().started) stack_.pop_back();
-            current_ = &caller;
-            current_->seek(*at);
-            return;
-        }
-        if (--top.remaining > 0) {
-            enter(top);
-            return;
-        }
-        const CallFrame done = top;
-        stack_.pop_back();
-        resume_after(done);
+        handle_return(*flow.ret, after_call);
         return;
     }
+    if (call_frame || !customs_.empty()) push_calls(call_frame, after_call);
+}
 
-    if (call_frame || !customs.empty()) {
-        // Queue so that the written call runs first, then the custom codes in written order.
-        for (std::size_t i = customs.size(); i-- > 0;) {
-            const CustomCall& cc = customs[i];
-            CallFrame f;
-            f.source = library_.get();
-            f.body = cc.site.pos;
-            f.return_source = current_;
-            f.return_pos = after_call;
-            f.label = program_label(cc.program, std::nullopt);
-            f.custom_code = cc.code;
-            stack_.push_back(f);
-        }
-        if (call_frame) {
-            call_frame->return_source = current_;
-            call_frame->return_pos = after_call;
-            stack_.push_back(*call_frame);
-        }
-        enter(stack_.back());
+void Interpreter::handle_label(const SourceLoc& loc) {
+    if (stack_.empty()) {
+        // A label before any block names the main program; after blocks it is the first
+        // subprogram, which the main program must not run into (S0 §3.12 ex. 5).
+        if (main_started_) end_program(loc);
+        return;
     }
+    const std::string label = stack_.back().label;
+    finished_ = true;
+    stack_.clear();
+    throw Error(loc, "subprogram " + label + " runs into the next label without M17");
+}
+
+std::optional<CallFrame> Interpreter::resolve_call(const CallRequest& c) {
+    const std::string label = program_label(c.program, c.name);
+    for (Source* s : {current_, main_.get(), library_.get()}) {
+        if (s == nullptr) continue;
+        const std::optional<LabelSite> site =
+            c.name ? s->find_label(*c.name) : s->find_label(c.program);
+        if (!site) continue;
+        if (c.count == 0) return std::nullopt;
+        CallFrame f;
+        f.source = s;
+        f.body = site->pos;
+        f.remaining = c.count;
+        f.label = label;
+        return f;
+    }
+    throw Error(c.loc, "subprogram " + label + " not found");
+}
+
+bool Interpreter::custom_code_active(int code) const {
+    for (const CallFrame& f : stack_)
+        if (f.custom_code == code) return true;
+    return false;
+}
+
+void Interpreter::collect_custom_codes(Block& b, bool has_call) {
+    const Dialect& d = *options_.dialect;
+    for (std::size_t i = 0; i < b.m.size();) {
+        const int m = b.m[i];
+        std::optional<LabelSite> site;
+        if (m <= d.custom_code_max && !custom_code_active(m))
+            site = library_->find_label(d.custom_m_base + m);
+        if (!site) {
+            ++i;
+            continue;
+        }
+        customs_.push_back(CustomCall{m, d.custom_m_base + m, *site});
+        b.m.erase_at(i);
+        b.m_col.erase_at(i);
+    }
+    for (std::size_t i = 0; i < b.g.size();) {
+        const int g = b.g[i];
+        const int n = g / 10;
+        std::optional<LabelSite> site;
+        if (g % 10 == 0 && n <= d.custom_code_max && !custom_code_active(kCustomGFlag + n))
+            site = library_->find_label(d.custom_g_base + n);
+        if (!site) {
+            ++i;
+            continue;
+        }
+        if (has_call) {
+            throw Error(SourceLoc{b.loc.file, b.loc.line, b.g_col[i]},
+                        "custom G" + std::to_string(n) + " and a subprogram call in one block");
+        }
+        customs_.push_back(CustomCall{kCustomGFlag + n, d.custom_g_base + n, *site});
+        b.g.erase_at(i);
+        b.g_col.erase_at(i);
+    }
+}
+
+void Interpreter::take_fixed_cycle_args(Block& b) {
+    // A custom G code takes the block's address words as its arguments (#FC…); the other G and
+    // M codes act first, as for ISO G macros (CUS-5, MACG-2).
+    fc_args_ = {};
+    for (const FcWord& w : kFcWords) {
+        const int i = letter_index(w.letter);
+        if (b.words[i]) {
+            fc_args_[w.fc] = b.words[i];
+            b.words[i].reset();
+        }
+    }
+}
+
+void Interpreter::set_fixed_cycle_vars(const SourceLoc& loc) {
+    for (std::size_t fc = 1; fc < fc_args_.size(); ++fc)
+        if (fc_args_[fc]) vars_.set_fixed_cycle(static_cast<int>(fc), *fc_args_[fc], loc);
+    vars_.set_fixed_cycle(12, machine_.cycle_return_to_r() ? 1.0 : 0.0, loc);
+    vars_.set_fixed_cycle(13, machine_.incremental_mode() ? 1.0 : 0.0, loc);
+    vars_.set_fixed_cycle(14, machine_.work_pos_mm(Axis::Z) / machine_.mm_per_program_unit(), loc);
+}
+
+void Interpreter::handle_return(const ReturnRequest& r, const SourcePos& after_call) {
+    if (stack_.empty()) {
+        return_in_main(r, after_call);
+        return;
+    }
+    CallFrame& top = stack_.back();
+    if (r.sequence) {
+        return_to_sequence(r, after_call);
+        return;
+    }
+    if (--top.remaining > 0) {
+        enter(top);
+        return;
+    }
+    const CallFrame done = top;
+    stack_.pop_back();
+    resume_after(done);
+}
+
+void Interpreter::return_in_main(const ReturnRequest& r, const SourcePos& after_call) {
+    if (r.m != 99) throw Error(r.loc, "M" + std::to_string(r.m) + " outside a subprogram");
+    if (!options_.main_m99_loops) {
+        end_program(r.loc);
+        return;
+    }
+    // S0 §3.4: M99 in the main program returns to its start (or to N n, SUB-8).
+    SourcePos target{};
+    if (r.sequence) {
+        const auto at = find_sequence(*main_, SourcePos{}, *r.sequence, std::nullopt);
+        if (!at) {
+            main_->seek(after_call);
+            throw Error(r.loc, "M99 P" + std::to_string(*r.sequence) + ": no block N" +
+                                   std::to_string(*r.sequence) + " in the main program");
+        }
+        target = *at;
+    }
+    main_->seek(target);
+    main_started_ = false;
+}
+
+void Interpreter::return_to_sequence(const ReturnRequest& r, const SourcePos& after_call) {
+    // SUB-7: return to the caller at N n, searching forward from the call, then from the start
+    // of the calling program.
+    const CallFrame done = stack_.back();
+    stack_.pop_back();
+    Source& caller = *done.return_source;
+    const SourcePos caller_start = stack_.empty() ? SourcePos{} : stack_.back().body;
+    std::optional<SourcePos> at = find_sequence(caller, done.return_pos, *r.sequence, std::nullopt);
+    if (!at) at = find_sequence(caller, caller_start, *r.sequence, done.return_pos.offset);
+    if (!at) {
+        stack_.push_back(done);
+        current_->seek(after_call);
+        throw Error(r.loc, "M99 P" + std::to_string(*r.sequence) + ": no block N" +
+                               std::to_string(*r.sequence) + " in the calling program");
+    }
+    // Queued calls of the same block are dropped: control left that block for good.
+    while (!stack_.empty() && !stack_.back().started) stack_.pop_back();
+    current_ = &caller;
+    current_->seek(*at);
+}
+
+void Interpreter::push_calls(std::optional<CallFrame>& call_frame, const SourcePos& after_call) {
+    // Queue so that the written call runs first, then the custom codes in written order.
+    for (std::size_t i = customs_.size(); i-- > 0;) {
+        const CustomCall& cc = customs_[i];
+        CallFrame f;
+        f.source = library_.get();
+        f.body = cc.site.pos;
+        f.return_source = current_;
+        f.return_pos = after_call;
+        f.label = program_label(cc.program, std::nullopt);
+        f.custom_code = cc.code;
+        stack_.push_back(f);
+    }
+    if (call_frame) {
+        call_frame->return_source = current_;
+        call_frame->return_pos = after_call;
+        stack_.push_back(*call_frame);
+    }
+    enter(stack_.back());
 }
 
 void Interpreter::enter(CallFrame& frame) {

@@ -10,37 +10,58 @@ namespace interp {
 
 std::string_view op_text(Op op) {
     switch (op) {
-        case Op::None: return "";
-        case Op::Plus: return "+";
-        case Op::Minus: return "-";
-        case Op::Star: return "*";
-        case Op::Slash: return "/";
-        case Op::Caret: return "^";
-        case Op::Not: return "!";
-        case Op::Assign: return "=";
-        case Op::EqEq: return "==";
-        case Op::NotEq: return "!=";
-        case Op::Less: return "<";
-        case Op::Greater: return ">";
-        case Op::LessEq: return "<=";
-        case Op::GreaterEq: return ">=";
-        case Op::AndAnd: return "&&";
-        case Op::OrOr: return "||";
-        case Op::Bar: return "|";
-        case Op::LParen: return "(";
-        case Op::RParen: return ")";
-        case Op::LBracket: return "[";
-        case Op::RBracket: return "]";
-        case Op::Comma: return ",";
+        case Op::None:
+            return "";
+        case Op::Plus:
+            return "+";
+        case Op::Minus:
+            return "-";
+        case Op::Star:
+            return "*";
+        case Op::Slash:
+            return "/";
+        case Op::Caret:
+            return "^";
+        case Op::Not:
+            return "!";
+        case Op::Assign:
+            return "=";
+        case Op::EqEq:
+            return "==";
+        case Op::NotEq:
+            return "!=";
+        case Op::Less:
+            return "<";
+        case Op::Greater:
+            return ">";
+        case Op::LessEq:
+            return "<=";
+        case Op::GreaterEq:
+            return ">=";
+        case Op::AndAnd:
+            return "&&";
+        case Op::OrOr:
+            return "||";
+        case Op::Bar:
+            return "|";
+        case Op::LParen:
+            return "(";
+        case Op::RParen:
+            return ")";
+        case Op::LBracket:
+            return "[";
+        case Op::RBracket:
+            return "]";
+        case Op::Comma:
+            return ",";
     }
     return "?";
 }
 
 namespace {
 
-constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
-                             1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
-                             1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
+                             1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
 // Parses [digits][.digits] starting at s[i]; the caller guarantees a digit or '.' there.
 // Integer mantissas below 2^53 divided by an exact power of ten round once, so the fast path is
@@ -97,31 +118,47 @@ Op scan_op(std::string_view s, std::size_t i, bool abs_bars, std::size_t& len) {
     if (c == '|' && n == '|' && !abs_bars) return Op::OrOr;
     len = 1;
     switch (c) {
-        case '+': return Op::Plus;
-        case '-': return Op::Minus;
-        case '*': return Op::Star;
-        case '/': return Op::Slash;
-        case '^': return Op::Caret;
-        case '!': return Op::Not;
-        case '=': return Op::Assign;
-        case '<': return Op::Less;
-        case '>': return Op::Greater;
-        case '|': return abs_bars ? Op::Bar : Op::None;
-        case '(': return Op::LParen;
-        case ')': return Op::RParen;
-        case '[': return Op::LBracket;
-        case ']': return Op::RBracket;
-        case ',': return Op::Comma;
-        default: return Op::None;
+        case '+':
+            return Op::Plus;
+        case '-':
+            return Op::Minus;
+        case '*':
+            return Op::Star;
+        case '/':
+            return Op::Slash;
+        case '^':
+            return Op::Caret;
+        case '!':
+            return Op::Not;
+        case '=':
+            return Op::Assign;
+        case '<':
+            return Op::Less;
+        case '>':
+            return Op::Greater;
+        case '|':
+            return abs_bars ? Op::Bar : Op::None;
+        case '(':
+            return Op::LParen;
+        case ')':
+            return Op::RParen;
+        case '[':
+            return Op::LBracket;
+        case ']':
+            return Op::RBracket;
+        case ',':
+            return Op::Comma;
+        default:
+            return Op::None;
     }
 }
 
 // A '(' opens a sub-expression when it follows something that needs an operand or an argument
 // list; anywhere else it opens a comment (CAM output writes "(…)" comments).
-bool paren_is_expression(const std::vector<Token>& out, int depth, bool expression_start) {
+bool paren_is_expression(const Token* previous, int depth, bool expression_start) {
     if (depth > 0) return true;
-    if (out.empty()) return expression_start;
-    const Token& prev = out.back();
+    if (previous == nullptr) return expression_start;
+    const Token& prev = *previous;
     if (prev.kind == Tok::Word) return prev.text.size() > 1;
     if (prev.kind == Tok::Op)
         return prev.op != Op::RParen && prev.op != Op::RBracket && prev.op != Op::Bar;
@@ -133,8 +170,8 @@ std::string describe_byte(char c) {
     if (u >= 0x20 && u < 0x7F) return std::string("unexpected character '") + c + "'";
     char buf[64];
     std::snprintf(buf, sizeof buf, "unexpected byte 0x%02X", u);
-    return std::string(buf) + (u >= 0x80 ? " (non-ASCII text belongs in a ' comment or a string)"
-                                         : "");
+    return std::string(buf) +
+           (u >= 0x80 ? " (non-ASCII text belongs in a ' comment or a string)" : "");
 }
 
 }  // namespace
@@ -142,6 +179,7 @@ std::string describe_byte(char c) {
 void Lexer::lex(std::string_view s, const SourceLoc& loc, std::vector<Token>& out,
                 bool expression_start) const {
     out.clear();
+    out.reserve(s.size() + 1);  // a line never has more tokens than bytes + End
     const Dialect& d = *dialect_;
     std::size_t i = 0;
     int depth = 0;
@@ -158,7 +196,8 @@ void Lexer::lex(std::string_view s, const SourceLoc& loc, std::vector<Token>& ou
         }
         if (c == ';') break;
         if (d.quote_comments && comment_quote_length(s.substr(i)) != 0) break;
-        Token tok;
+        // Built in place: copying a finished Token into the vector stalls on store forwarding.
+        Token& tok = out.emplace_back();
         tok.col = static_cast<int>(i) + 1;
         tok.space_before = space;
         space = false;
@@ -198,7 +237,10 @@ void Lexer::lex(std::string_view s, const SourceLoc& loc, std::vector<Token>& ou
             tok.kind = Tok::String;
             tok.text = s.substr(i + q, j - i - q);
             i = j + quote_length(s.substr(j));
-        } else if (c == '(' && !paren_is_expression(out, depth, expression_start)) {
+        } else if (c == '(' &&
+                   !paren_is_expression(out.size() >= 2 ? &out[out.size() - 2] : nullptr, depth,
+                                        expression_start)) {
+            out.pop_back();  // not a token: a comment
             if (!d.paren_comments) error(i, "'(' comments are not allowed in this dialect");
             int nest = 0;
             std::size_t j = i;
@@ -221,12 +263,10 @@ void Lexer::lex(std::string_view s, const SourceLoc& loc, std::vector<Token>& ou
             tok.text = s.substr(i, len);
             i += len;
         }
-        out.push_back(tok);
     }
-    Token end;
+    Token& end = out.emplace_back();
     end.col = static_cast<int>(i) + 1;
     end.space_before = true;
-    out.push_back(end);
 }
 
 }  // namespace interp

@@ -9,7 +9,7 @@
 namespace interp {
 
 void ParsedLine::reset() {
-    block = Block{};
+    block.clear();
     is_label = false;
     label_number = -1;
     label_name.clear();
@@ -31,7 +31,9 @@ struct BlockParser::Ctx {
 
 namespace {
 
-std::string quoted(std::string_view s) { return "'" + std::string(s) + "'"; }
+std::string quoted(std::string_view s) {
+    return "'" + std::string(s) + "'";
+}
 
 // Per-axis keyword: "FX" -> 0, "FY" -> 1, "FZ" -> 2 when the first letter matches.
 int axis_keyword(std::string_view w, char first) {
@@ -79,7 +81,9 @@ void BlockParser::parse_word(Ctx& c) {
                 parse_keyword(c, t);
             }
             return;
-        case Tok::Var: parse_assignment(c, t); return;
+        case Tok::Var:
+            parse_assignment(c, t);
+            return;
         case Tok::String:
             // V5.4 writes M801 "text" without MSG (S1 §3.4).
             if (c.dry) return;
@@ -90,7 +94,8 @@ void BlockParser::parse_word(Ctx& c) {
             throw Error(c.at(t), "number " + quoted(t.text) + " without an address letter");
         case Tok::Op:
             throw Error(c.at(t), "unexpected " + quoted(t.text) + " where a word should start");
-        case Tok::End: return;
+        case Tok::End:
+            return;
     }
 }
 

@@ -108,9 +108,10 @@ void Source::index_line(std::string_view line, SourcePos pos) {
         }
         auto [it, inserted] = numbered_.emplace(number, site);
         if (!inserted) {
-            throw Error(SourceLoc{name_, pos.line, col},
-                        "subprogram O" + std::to_string(number) + " is defined twice (first at line " +
-                            std::to_string(it->second.pos.line) + ")");
+            throw Error(SourceLoc{name_, pos.line, col}, "subprogram O" + std::to_string(number) +
+                                                             " is defined twice (first at line " +
+                                                             std::to_string(it->second.pos.line) +
+                                                             ")");
         }
         return;
     }
@@ -122,10 +123,10 @@ void Source::index_line(std::string_view line, SourcePos pos) {
     std::string key = to_upper(line.substr(i, end - i));
     auto [it, inserted] = named_.emplace(key, site);
     if (!inserted) {
-        throw Error(SourceLoc{name_, pos.line, col},
-                    "subprogram O\"" + std::string(line.substr(i, end - i)) +
-                        "\" is defined twice (first at line " +
-                        std::to_string(it->second.pos.line) + ")");
+        throw Error(SourceLoc{name_, pos.line, col}, "subprogram O\"" +
+                                                         std::string(line.substr(i, end - i)) +
+                                                         "\" is defined twice (first at line " +
+                                                         std::to_string(it->second.pos.line) + ")");
     }
 }
 

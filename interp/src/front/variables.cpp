@@ -7,7 +7,8 @@ namespace interp {
 
 namespace {
 void check_finite(double v, const std::string& name, const SourceLoc& loc) {
-    if (!std::isfinite(v)) throw Error(loc, "value assigned to " + name + " is not a finite number");
+    if (!std::isfinite(v))
+        throw Error(loc, "value assigned to " + name + " is not a finite number");
 }
 }  // namespace
 
