@@ -170,6 +170,27 @@ TEST(CutterComp, InsideCornersAreTrimmedToTheIntersection) {
                "L 9,9 -> 1,9 contour #4", "L 1,9 -> 1,0 contour #5", "L 1,0 -> 5,5 cancel #6"}));
 }
 
+TEST(CutterComp, IsoCancelAtAnInsideCornerStopsAtTheOffsetCrossing) {
+    // As above with the ISO cancel: the cancel back to the centre turns toward the
+    // tool, so the last move stops where its offset x = 1 meets the cancel line
+    // shifted left by 1, y = x + √2, instead of running on to (1, 0) next to the
+    // bottom edge.
+    Config cfg;
+    cfg.cancel_at_inside_corner = CancelCorner::Intersection;
+    Compensator c(cfg, {5, 5});
+    const Lines out = run(c, {line(0, 0, L, 1, 1), line(10, 0, L, 1, 2), line(10, 10, L, 1, 3),
+                              line(0, 10, L, 1, 4), line(0, 0, L, 1, 5), line(5, 5, Off, 1, 6)});
+    ASSERT_EQ(out.size(), 6u);
+    EXPECT_EQ(out[4], "L 1,9 -> 1,2.41421 contour #5");
+    EXPECT_EQ(out[5], "L 1,2.41421 -> 5,5 cancel #6");
+    // An outside cancel is unchanged: the manual's program 2.
+    Compensator p2(cfg);
+    EXPECT_EQ(
+        run(p2, {line(10, 10, L, 2, 2, true), line(20, 10, L, 2, 3), line(0, 0, Off, 2, 4, true)})
+            .back(),
+        "L 20,12 -> 0,0 cancel #4");
+}
+
 TEST(CutterComp, FullCircleInsideShrinksTheRadius) {
     // G41 G1 X10 / G3 X10 Y0 I-10 (full CCW circle, tool inside) / G40 G1 X0, r 2.
     Compensator c;

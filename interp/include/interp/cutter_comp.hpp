@@ -27,7 +27,8 @@
 //     position to the point on the perpendicular of the next move at its start
 //     (S0 §3.5.3 "offset to the perpendicular at the block start"); cancel
 //     (a line with side Off): from the perpendicular at the end of the last move
-//     to the programmed end point.
+//     (or, Config::cancel_at_inside_corner, the crossing with the cancel move's
+//     offset when the cancel turns toward the tool) to the programmed end point.
 //   - corners: inside (the turn is toward the tool side) → the two offset curves
 //     are trimmed to their intersection; outside → an arc of radius r around the
 //     programmed corner point, or (Config::extend_max_turn_deg) the two offset
@@ -123,12 +124,19 @@ enum class OnLookaheadExhausted {
     Perpendicular,  // end the held move on its perpendicular and restart like a start-up
 };
 
+/// Where the last compensated move ends when the cancel move turns toward the tool side.
+enum class CancelCorner {
+    Perpendicular,  // on the perpendicular at its end (NcStudio, S0 §3.5.3 figures)
+    Intersection,   // where its offset meets the cancel move's offset (ISO CRC-10)
+};
+
 struct Config {
     /// Moves without plane motion allowed between two contour moves.
     std::size_t lookahead_moves = 5;
     OnLookaheadExhausted on_exhausted = OnLookaheadExhausted::Error;
     /// Outside corners that turn by at most this angle use extended lines; 0 = always an arc.
     double extend_max_turn_deg = 0.0;
+    CancelCorner cancel_at_inside_corner = CancelCorner::Perpendicular;
 };
 
 class Compensator {

@@ -180,6 +180,27 @@ Curve offset_or_throw(const Segment& seg, const Move& move, SourceTag on_tag) {
     return *curve;
 }
 
+/// The intersection of two offset curves nearest the programmed corner that lies
+/// on what is left of the first (from u_start) and on the second: (u on a, u on b).
+std::optional<std::pair<double, double>> inside_joint(const Curve& a, double a_u_start,
+                                                      const Curve& b, const Vec2& corner) {
+    std::optional<std::pair<double, double>> best;
+    double best_dist = 0.0;
+    for (const Vec2& p : geom::intersections(a, b)) {
+        double ua = a.param(p);
+        if (full_circle(a) && ua <= a.tol_u()) ua = 1.0;
+        const double ub = b.param(p);
+        const bool on_a = ua >= a_u_start - a.tol_u() && ua <= 1.0 + a.tol_u();
+        const bool on_b = ub >= -b.tol_u() && ub <= 1.0 + b.tol_u();
+        const double dist = (p - corner).norm();
+        if (on_a && on_b && (!best || dist < best_dist)) {
+            best = std::make_pair(std::clamp(ua, a_u_start, 1.0), std::clamp(ub, 0.0, 1.0));
+            best_dist = dist;
+        }
+    }
+    return best;
+}
+
 void check_reversal(const Vec2& t_in, const Vec2& t_out, SourceTag a, SourceTag b) {
     if (std::abs(geom::cross(t_in, t_out)) <= kParallel && t_in.dot(t_out) < 0)
         throw CompError(fmt::format("cutter comp: path reversal between line {} and line {}", a, b),
@@ -239,21 +260,7 @@ void Compensator::join(const Move& move) {
     } else if (s * turn_sin > 0) {
         // Inside corner: trim both offsets to their intersection nearest the
         // corner, which must lie within what is left of each move.
-        const Vec2 corner = seg.start;
-        std::optional<std::pair<double, double>> best;
-        double best_dist = 0.0;
-        for (const Vec2& p : geom::intersections(a.curve, next)) {
-            double ua = a.curve.param(p);
-            if (full_circle(a.curve) && ua <= a.curve.tol_u()) ua = 1.0;
-            const double ub = next.param(p);
-            const bool inside_a = ua >= a.u_start - a.curve.tol_u() && ua <= 1.0 + a.curve.tol_u();
-            const bool inside_b = ub >= -next.tol_u() && ub <= 1.0 + next.tol_u();
-            const double dist = (p - corner).norm();
-            if (inside_a && inside_b && (!best || dist < best_dist)) {
-                best = std::make_pair(std::clamp(ua, a.u_start, 1.0), std::clamp(ub, 0.0, 1.0));
-                best_dist = dist;
-            }
-        }
+        const auto best = inside_joint(a.curve, a.u_start, next, seg.start);
         if (!best)
             throw CompError(
                 fmt::format("cutter comp: gouge: the tool radius {:g} does not fit the inside "
@@ -296,9 +303,27 @@ void Compensator::cancel(const Move& move) {
                                     "(line {}, after line {}); cancel it with G00/G01",
                                     move.tag, pending_->move.tag),
                         pending_->move.tag, move.tag);
-    if (pending_->kind != Pending::Kind::Resume) {
+    if (pending_->kind == Pending::Kind::Contour) {
+        Pending& a = *pending_;
         const Segment seg = Segment::make(programmed_, programmed_h_, move);
-        check_reversal(pending_->seg.tangent(1.0), seg.tangent(0.0), pending_->move.tag, move.tag);
+        const Vec2 t_in = a.seg.tangent(1.0);
+        const Vec2 t_out = seg.tangent(0.0);
+        check_reversal(t_in, t_out, a.move.tag, move.tag);
+        // CRC-10 (ISO): at an inside corner the perpendicular end would cut into
+        // the cancel move's side, so stop where the offsets of both moves cross; a
+        // cancel move too short for that leaves from the perpendicular.
+        const double turn_sin = geom::cross(t_in, t_out);
+        if (config_.cancel_at_inside_corner == CancelCorner::Intersection && a.move.radius_mm > 0 &&
+            side_sign(a.move.side) * turn_sin > kParallel) {
+            const auto exit_offset = geom::offset(seg, side_sign(a.move.side) * a.move.radius_mm);
+            const auto joint = inside_joint(a.curve, a.u_start, *exit_offset, seg.start);
+            if (joint) {
+                emit_piece(a.curve.piece(a.u_start, joint->first), a.move.rapid, Role::Contour,
+                           a.move.tag);
+                a.kind = Pending::Kind::Resume;
+                flush_held();
+            }
+        }
     }
     end_pending_perpendicular();
     pending_.reset();
