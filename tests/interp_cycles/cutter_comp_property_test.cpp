@@ -218,3 +218,70 @@ TEST(CutterCompProperty, RandomClosedContoursKeepExactlyTheRadius) {
 }
 
 }  // namespace
+
+namespace {
+
+// Random, mostly invalid programs: the compensator either accepts them with a
+// continuous, finite output path or rejects them with a CompError; nothing else.
+TEST(CutterCompProperty, ArbitraryInputFailsCleanlyOrStaysContinuous) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    int rejected = 0, accepted = 0;
+    for (int program = 0; program < 2000; ++program) {
+        Config cfg;
+        cfg.lookahead_moves = static_cast<std::size_t>(4 * u(rng));
+        cfg.on_exhausted =
+            u(rng) < 0.5 ? OnLookaheadExhausted::Error : OnLookaheadExhausted::Perpendicular;
+        cfg.extend_max_turn_deg = 120 * u(rng);
+        cfg.cancel_at_inside_corner =
+            u(rng) < 0.5 ? CancelCorner::Perpendicular : CancelCorner::Intersection;
+        Compensator comp(cfg);
+        Vec2 at(0, 0);
+        std::vector<Output> out;
+        try {
+            for (int i = 0; i < 12; ++i) {
+                if (u(rng) < 0.1) {
+                    comp.push(Marker{i});
+                    continue;
+                }
+                Move m;
+                m.tag = i;
+                m.end = u(rng) < 0.15 ? at : Vec2(20 * u(rng) - 10, 20 * u(rng) - 10);
+                m.end_h = u(rng) < 0.2 ? -5 * u(rng) : 0.0;
+                if (u(rng) < 0.3) {
+                    m.shape = Shape::Arc;
+                    m.ccw = u(rng) < 0.5;
+                    // The centre on the bisector keeps the radius consistent, as the
+                    // executor's arc check guarantees.
+                    const Vec2 mid = (at + m.end) / 2, d = m.end - at;
+                    m.centre = mid + Vec2(-d.y(), d.x()) * (2 * u(rng) - 1);
+                }
+                const double side = u(rng);
+                m.side = side < 0.3 ? Side::Off : side < 0.65 ? Side::Left : Side::Right;
+                m.radius_mm = 3 * u(rng) - 0.5;
+                m.plane = u(rng) < 0.03 ? 18 : 17;
+                comp.push(m);
+                at = m.end;
+                for (auto& o : comp.drain()) out.push_back(o);
+            }
+            comp.finish();
+            for (auto& o : comp.drain()) out.push_back(o);
+            ++accepted;
+        } catch (const CompError&) {
+            ++rejected;
+            continue;
+        }
+        Vec2 tool(0, 0);
+        for (const Output& o : out) {
+            const auto* m = std::get_if<OutMove>(&o);
+            if (!m) continue;
+            ASSERT_TRUE(std::isfinite(m->end.x()) && std::isfinite(m->end.y())) << program;
+            ASSERT_LT((m->start - tool).norm(), 1e-6) << "program " << program << " tag " << m->tag;
+            tool = m->end;
+        }
+    }
+    EXPECT_GT(accepted, 100);
+    EXPECT_GT(rejected, 100);
+}
+
+}  // namespace

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "cycle_test_util.hpp"
@@ -70,6 +71,59 @@ TEST(CycleProperty, MotionStaysBetweenRInitialLevelAndZ) {
         holes_checked += reached_z;
     }
     EXPECT_GT(holes_checked, 3000);
+}
+
+}  // namespace
+
+namespace {
+
+// Random word combinations over several blocks: each block either succeeds with
+// finite moves or throws CycleError, and a throwing block leaves the data as it was.
+TEST(CycleProperty, ArbitraryWordsFailCleanly) {
+    std::mt19937 rng(99);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    auto maybe = [&](double p, double lo, double hi) -> std::optional<double> {
+        if (u(rng) >= p) return std::nullopt;
+        return lo + (hi - lo) * u(rng);
+    };
+    int errors = 0, blocks = 0;
+    for (int program = 0; program < 500; ++program) {
+        CycleState st;
+        BlockContext ctx;
+        ctx.position_mm = {0, 0, 10};
+        ctx.feed_mm_min = u(rng) < 0.9 ? 500 : 0;
+        ctx.spindle = static_cast<Spindle>(static_cast<int>(3 * u(rng)));
+        CycleConfig cfg;
+        cfg.oss_direction = static_cast<int>(6 * u(rng)) - 1;
+        cfg.retract_mm = 2 * u(rng) - 0.2;
+        for (int b = 0; b < 6; ++b) {
+            CycleWords w;
+            w.axis_mm = {maybe(0.5, -20, 20), maybe(0.5, -20, 20), maybe(0.5, -30, 15)};
+            w.r_mm = maybe(0.5, -10, 12);
+            w.q_mm = maybe(0.4, -3, 3);
+            w.p_ms = maybe(0.3, -100, 2000);
+            if (u(rng) < 0.3) w.k = static_cast<long>(6 * u(rng)) - 1;
+            ctx.incremental = u(rng) < 0.3;
+            ctx.return_to_r = u(rng) < 0.5;
+            std::optional<CycleCode> code;
+            if (u(rng) < 0.4 || !st.active()) code = kAll[static_cast<int>(12 * u(rng))];
+            const CycleData before = st.data();
+            ++blocks;
+            try {
+                const Expansion e = st.run_block(code, w, ctx, cfg);
+                ASSERT_LE(e.steps.size(), 2000000u);
+                ctx.position_mm = end_position(e, ctx.position_mm);
+                for (double v : ctx.position_mm) ASSERT_TRUE(std::isfinite(v));
+            } catch (const CycleError&) {
+                ++errors;
+                EXPECT_EQ(st.data().code, before.code);
+                EXPECT_EQ(st.data().z_level_mm, before.z_level_mm);
+                EXPECT_EQ(st.data().r_level_mm, before.r_level_mm);
+            }
+        }
+    }
+    EXPECT_GT(errors, 100);
+    EXPECT_LT(errors, blocks);
 }
 
 }  // namespace
