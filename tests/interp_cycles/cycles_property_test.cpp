@@ -37,9 +37,11 @@ TEST(CycleProperty, MotionStaysBetweenRInitialLevelAndZ) {
         cfg.retract_mm = 2 * u(rng);
         cfg.oss_direction = static_cast<int>(4 * u(rng));
         cfg.g88_retract = u(rng) < 0.5 ? G88Retract::Feed : G88Retract::Manual;
-        // Absolute levels: R below the initial level, Z below R (G87: above R).
+        // Absolute levels: R below the initial level, Z below R (G87: between R and
+        // the initial level).
         const double r_abs = initial - 20 * u(rng);
-        const double z_abs = back ? r_abs + 0.1 + 10 * u(rng) : r_abs - 0.1 - 30 * u(rng);
+        const double z_abs =
+            back ? r_abs + (initial - r_abs) * (0.05 + 0.95 * u(rng)) : r_abs - 0.1 - 30 * u(rng);
         const long k = 1 + static_cast<long>(3 * u(rng));
         Words w;
         w.x(20 * u(rng) - 10).y(20 * u(rng) - 10).q(0.2 + 5 * u(rng)).p(1000 * u(rng)).k(k);

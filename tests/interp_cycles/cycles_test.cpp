@@ -342,6 +342,15 @@ TEST(CycleData, IncrementalZWithoutRStartsFromTheInitialLevel) {
     EXPECT_EQ(lines, (Lines{"feed X0 Y0 Z-2 F800", "rapid X0 Y0 Z10"}));
 }
 
+TEST(CycleData, G98NeverReturnsBelowR) {
+    // The cycle starts with the tool at Z-2, below R0: G98 returns to R, not to -2.
+    Session s;
+    s.ctx.position_mm = {0, 0, -2};
+    EXPECT_EQ(
+        s.run(CycleCode::G81, Words().x(5).z(-10).r(0)),
+        (Lines{"rapid X5 Y0 Z-2", "rapid X5 Y0 Z0", "feed X5 Y0 Z-10 F800", "rapid X5 Y0 Z0"}));
+}
+
 TEST(CycleData, IsoDrillAxisFollowsThePlane) {
     // G18 (ZX plane): the hole position is in Z and X, the drilling axis is Y.
     Session s;
@@ -395,6 +404,13 @@ TEST(CycleErrors, EachMessage) {
         Session s;
         EXPECT_EQ(error_of(s, CycleCode::G81, Words().x(5).z(-1).r(-5)),
                   "G81: the hole bottom Z (-1) lies above the R plane (-5)");
+    }
+    {
+        Session s;
+        s.ctx.position_mm = {0, 0, -8};
+        EXPECT_EQ(error_of(s, CycleCode::G87, Words().x(5).z(-5).r(-15)),
+                  "G87 back boring: the initial level (-8) must lie above Z (-5), the tool returns "
+                  "there past the bore");
     }
     {
         Session s;

@@ -64,8 +64,10 @@ class Emitter {
     Expansion& out_;
 };
 
+// G98 never returns below R: a cycle started with the tool under the R plane
+// would otherwise move between holes below R.
 double return_level(const HoleSpec& h) {
-    return h.return_to_r ? h.r_mm : h.initial_mm;
+    return h.return_to_r ? h.r_mm : std::max(h.initial_mm, h.r_mm);
 }
 
 /// Steps 1–2 of every cycle but G87: position in the plane, rapid to R.
@@ -246,6 +248,11 @@ void check_levels(const HoleSpec& h) {
                 "G87 back boring: the R plane ({:g}) is the hole bottom and must lie below Z "
                 "({:g})",
                 h.r_mm, h.z_mm));
+        if (h.initial_mm < h.z_mm)
+            throw CycleError(fmt::format(
+                "G87 back boring: the initial level ({:g}) must lie above Z ({:g}), the tool "
+                "returns there past the bore",
+                h.initial_mm, h.z_mm));
     } else if (h.z_mm > h.r_mm) {
         throw CycleError(fmt::format("G{}: the hole bottom Z ({:g}) lies above the R plane ({:g})",
                                      g_number(h.code), h.z_mm, h.r_mm));
