@@ -10,7 +10,8 @@
 
 namespace interp {
 
-// One command per line in the native form (to_text).
+// One command per line in the native form (to_text); commands from a file other than the first
+// one seen are prefixed with that file's name.
 class NativePrinter final : public CanonSink {
 public:
     explicit NativePrinter(std::FILE* out) : out_(out) {}
@@ -18,6 +19,7 @@ public:
 
 private:
     std::FILE* out_;
+    std::string main_file_;
 };
 
 // Prints what LinuxCNC 2.9's `rs274 -g` prints for the subset both interpreters share (G0–G3,

@@ -29,6 +29,9 @@ struct BackendConfig {
     bool t_changes_tool = true;       // cfg:t_changes_tool (NcStudio 6th: T changes the tool)
     bool end_stops_spindle = true;    // AUTOSTOPSPINDLE: M02/M30 stop spindle and coolant
     double max_rapid_mm_s = 0;        // clamp for F in G00 blocks; 0 = no clamp
+    // The machine's default cutting feed, used by a feed move when no F was ever programmed
+    // (NcStudio always has one; the manual's examples rely on it). 0 = such a move is an error.
+    double default_feed_mm_s = 0;
     AxisVec reference_mm{};           // G28 reference point, machine coordinates
     AxisVec home_position_mm{};       // M902: machine origin position parameter per axis
     std::uint64_t input_bits = 0;     // standalone model of the input ports

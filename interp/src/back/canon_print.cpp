@@ -11,7 +11,11 @@ namespace interp {
 // ---------------------------------------------------------------------------------------------
 
 void NativePrinter::emit(const Canon& c) {
-    const std::string s = to_text(c);
+    if (main_file_.empty()) main_file_ = std::string(c.loc.file);
+    // Lines of the main program print as "12"; others (public.dat, …) as "public.dat:12".
+    const std::string s = c.loc.file == main_file_
+                              ? to_text(c)
+                              : fmt::format("{}:{} {}", c.loc.file, c.loc.line, to_text(c.cmd));
     std::fputs(s.c_str(), out_);
     std::fputc('\n', out_);
 }

@@ -207,6 +207,7 @@ private:
     void update_tool_offset(const SourceLoc& loc);
     AxisVec programmed_target() const;
     void require_no_scaling(int code) const;
+    void require_feed(const char* what);
 
     void emit_rapid(const AxisVec& end);
     void move_line(bool rapid, bool machine_coords);
@@ -348,7 +349,7 @@ void BlockRun::announce_offsets() {
 }
 
 // Recomputes the active tool offset vector after G43/G44/G49, a tool change or G923, and
-// announces it when it changed. The tool does not move (CS-3).
+// announces it when it changed. Nothing moves in this block unless it has motion words.
 void BlockRun::update_tool_offset(const SourceLoc& loc) {
     std::array<double, 3> v{};
     if (st.tool.length_mode != ToolLengthMode::Off) {
@@ -365,7 +366,9 @@ void BlockRun::update_tool_offset(const SourceLoc& loc) {
     if (v == st.tool.offset_mm) return;
     st.tool.offset_mm = v;
     emit(canon::ToolOffset{v});
-    resync_prog();
+    // The programmed position is kept, so the next move (absolute or incremental) carries the new
+    // offset, as on NcStudio/Fanuc: `G91 G43 Z-17 H01` moves 17 plus the tool length, and a later
+    // G49 block takes the length back out (FEATURES EX-18 returns to its start).
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -878,6 +881,17 @@ void BlockRun::emit_rapid(const AxisVec& end) {
     st.pos.machine_mm = end;
 }
 
+void BlockRun::require_feed(const char* what) {
+    if (st.feed.feed_set && st.feed.feed_mm_s > 0) return;
+    if (!st.feed.feed_set && cfg_.default_feed_mm_s > 0) {
+        st.feed.feed_mm_s = cfg_.default_feed_mm_s;
+        st.feed.feed_set = true;
+        emit(canon::SetFeedRate{st.feed.feed_mm_s});
+        return;
+    }
+    fail(b_.loc, fmt::format("no feed rate programmed (F) for {}", what));
+}
+
 void BlockRun::move_line(bool rapid, bool machine_coords) {
     AxisVec end;
     if (machine_coords) {
@@ -891,8 +905,7 @@ void BlockRun::move_line(bool rapid, bool machine_coords) {
     if (rapid) {
         emit_rapid(end);
     } else {
-        if (!st.feed.feed_set || st.feed.feed_mm_s <= 0)
-            fail(b_.loc, "no feed rate programmed (F) for a feed move");
+        require_feed("a feed move");
         emit(canon::FeedLine{end, flags_});
         st.pos.machine_mm = end;
     }
@@ -903,8 +916,7 @@ void BlockRun::move_line(bool rapid, bool machine_coords) {
 }
 
 void BlockRun::move_arc(bool ccw) {
-    if (!st.feed.feed_set || st.feed.feed_mm_s <= 0)
-        fail(b_.loc, "no feed rate programmed (F) for an arc");
+    require_feed("an arc");
     const PlaneAxes pa = plane_axes(st.motion.plane);
     // The arc starts where the machine is, seen in the current program frame.
     const AxisVec start = prog_of_machine(st.pos.machine_mm);
