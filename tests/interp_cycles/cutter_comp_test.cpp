@@ -161,28 +161,18 @@ TEST(CutterComp, ExtendedLineCornersWhenConfigured) {
 }
 
 TEST(CutterComp, InsideCornersAreTrimmedToTheIntersection) {
-    // The same square with G41 (tool inside), from the centre.
-    Compensator c(Config{}, {5, 5});
-    EXPECT_EQ(
-        run(c, {line(0, 0, L, 1, 1), line(10, 0, L, 1, 2), line(10, 10, L, 1, 3),
-                line(0, 10, L, 1, 4), line(0, 0, L, 1, 5), line(5, 5, Off, 1, 6)}),
-        (Lines{"L 5,5 -> 0,1 startup #1", "L 0,1 -> 9,1 contour #2", "L 9,1 -> 9,9 contour #3",
-               "L 9,9 -> 1,9 contour #4", "L 1,9 -> 1,0 contour #5", "L 1,0 -> 5,5 cancel #6"}));
-}
-
-TEST(CutterComp, IsoCancelAtAnInsideCornerStopsAtTheOffsetCrossing) {
-    // As above with the ISO cancel: the cancel back to the centre turns toward the
-    // tool, so the last move stops where its offset x = 1 meets the cancel line
-    // shifted left by 1, y = x + √2, instead of running on to (1, 0) next to the
-    // bottom edge.
+    // The same square with G41 (tool inside), from the centre and back with the
+    // ISO cancel: the cancel turns toward the tool (inside), so the last move
+    // stops where its offset x = 1 meets the cancel line shifted left by 1,
+    // y = x + √2, instead of running on to (1, 0) next to the bottom edge.
     Config cfg;
     cfg.cancel_at_inside_corner = CancelCorner::Intersection;
     Compensator c(cfg, {5, 5});
-    const Lines out = run(c, {line(0, 0, L, 1, 1), line(10, 0, L, 1, 2), line(10, 10, L, 1, 3),
-                              line(0, 10, L, 1, 4), line(0, 0, L, 1, 5), line(5, 5, Off, 1, 6)});
-    ASSERT_EQ(out.size(), 6u);
-    EXPECT_EQ(out[4], "L 1,9 -> 1,2.41421 contour #5");
-    EXPECT_EQ(out[5], "L 1,2.41421 -> 5,5 cancel #6");
+    EXPECT_EQ(run(c, {line(0, 0, L, 1, 1), line(10, 0, L, 1, 2), line(10, 10, L, 1, 3),
+                      line(0, 10, L, 1, 4), line(0, 0, L, 1, 5), line(5, 5, Off, 1, 6)}),
+              (Lines{"L 5,5 -> 0,1 startup #1", "L 0,1 -> 9,1 contour #2",
+                     "L 9,1 -> 9,9 contour #3", "L 9,9 -> 1,9 contour #4",
+                     "L 1,9 -> 1,2.41421 contour #5", "L 1,2.41421 -> 5,5 cancel #6"}));
     // An outside cancel is unchanged: the manual's program 2.
     Compensator p2(cfg);
     EXPECT_EQ(
@@ -389,6 +379,38 @@ TEST(CutterCompErrors, GougeWhenTheToolDoesNotFitAnInsideCorner) {
         e.what(),
         "cutter comp: gouge: the tool radius 6 does not fit the inside corner between line "
         "3 and line 4");
+}
+
+TEST(CutterCompErrors, GougeIntoAnEarlierMove) {
+    // The perpendicular cancel (default) of the inside square ends the last
+    // move at (1, 0), on the bottom edge (line 2): the look-back check refuses it.
+    const CompError e =
+        error_of({line(0, 0, L, 1, 1), line(10, 0, L, 1, 2), line(10, 10, L, 1, 3),
+                  line(0, 10, L, 1, 4), line(0, 0, L, 1, 5), line(5, 5, Off, 1, 6)});
+    EXPECT_STREQ(e.what(),
+                 "cutter comp: gouge: the tool path of line 5 comes within 0 of the contour of "
+                 "line 2 (tool radius 1)");
+    EXPECT_EQ(e.first_block, 2);
+    EXPECT_EQ(e.second_block, 5);
+    // Non-adjacent moves: line 6 runs back 2 above line 2 with r = 1.5 on the
+    // side facing it. Every corner is fine locally (the corners between are
+    // 10–20 long), but the corner before line 6 and line 6 itself pass 0.5 from line 2.
+    const CompError far =
+        error_of({line(0, 0, L, 1.5, 1), line(20, 0, L, 1.5, 2), line(20, 20, L, 1.5, 3),
+                  line(10, 20, L, 1.5, 4), line(10, 2, L, 1.5, 5), line(0, 2, L, 1.5, 6),
+                  line(-5, 2, Off, 1.5, 7)},
+                 Config{}, {0, -5});
+    EXPECT_STREQ(far.what(),
+                 "cutter comp: gouge: the tool path of line 6 comes within 0.5 of the contour of "
+                 "line 2 (tool radius 1.5)");
+    Config off;
+    off.gouge_check_moves = 0;
+    EXPECT_STREQ(error_of({line(0, 0, L, 1.5, 1), line(20, 0, L, 1.5, 2), line(20, 20, L, 1.5, 3),
+                           line(10, 20, L, 1.5, 4), line(10, 2, L, 1.5, 5), line(0, 2, L, 1.5, 6),
+                           line(-5, 2, Off, 1.5, 7)},
+                          off, {0, -5})
+                     .what(),
+                 "no error");
 }
 
 TEST(CutterCompErrors, PlaneChangeWhileActive) {

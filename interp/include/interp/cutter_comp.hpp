@@ -34,7 +34,9 @@
 //     programmed corner point, or (Config::extend_max_turn_deg) the two offset
 //     tangents extended to their intersection for mild turns.
 //   - errors (CompError, naming both blocks involved): a 180° reversal, an inside
-//     corner whose offset curves do not meet within both moves (gouge), a tool
+//     corner whose offset curves do not meet within both moves (gouge), an offset
+//     piece that comes closer than r to one of the last few contour moves at the
+//     same height (gouge, Config::gouge_check_moves; checked at 64 points), a tool
 //     radius ≥ an inside arc radius, a plane change while active, start-up or
 //     cancel on an arc, too many moves without plane motion.
 //
@@ -126,8 +128,8 @@ enum class OnLookaheadExhausted {
 
 /// Where the last compensated move ends when the cancel move turns toward the tool side.
 enum class CancelCorner {
-    Perpendicular,  // on the perpendicular at its end (NcStudio, S0 §3.5.3 figures)
-    Intersection,   // where its offset meets the cancel move's offset (ISO CRC-10)
+    Perpendicular,  // on the perpendicular at its end, like the start-up (S0 §3.5.3 figures)
+    Intersection,   // where its offset meets the cancel move's offset (ISO CRC-10, Fanuc)
 };
 
 struct Config {
@@ -137,6 +139,9 @@ struct Config {
     /// Outside corners that turn by at most this angle use extended lines; 0 = always an arc.
     double extend_max_turn_deg = 0.0;
     CancelCorner cancel_at_inside_corner = CancelCorner::Perpendicular;
+    /// Every offset piece is checked against this many preceding contour moves
+    /// (and the next one): closer than the radius is a gouge error. 0 = off.
+    std::size_t gouge_check_moves = 8;
 };
 
 class Compensator {
@@ -178,6 +183,7 @@ class Compensator {
     void flush_held();
     void emit_line(const Vec2& to, double to_h, bool rapid, Role role, SourceTag tag);
     void emit_piece(OutMove piece, bool rapid, Role role, SourceTag tag);
+    void check_gouge(const OutMove& piece, double radius_mm) const;
 
     Config config_;
     Vec2 programmed_;  // uncompensated end of the last block

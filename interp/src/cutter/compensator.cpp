@@ -31,6 +31,13 @@ double side_sign(Side side) {
     return side == Side::Left ? 1.0 : -1.0;
 }
 
+Vec2 sample(const OutMove& m, double t) {
+    if (m.shape == Shape::Line) return m.start + (m.end - m.start) * t;
+    const Vec2 r0 = m.start - m.centre;
+    const double a = std::atan2(r0.y(), r0.x()) + (m.ccw ? 1.0 : -1.0) * m.sweep_rad * t;
+    return m.centre + r0.norm() * Vec2(std::cos(a), std::sin(a));
+}
+
 bool full_circle(const Curve& c) {
     return c.shape == Shape::Arc && c.sweep >= 2.0 * std::numbers::pi - 1e-12;
 }
@@ -39,12 +46,31 @@ bool full_circle(const Curve& c) {
 
 struct Compensator::Pending {
     enum class Kind { StartUp, Contour, Resume };
+    struct Recent {
+        Segment seg;
+        SourceTag tag;
+    };
     Kind kind = Kind::StartUp;
-    Segment seg;       // the programmed move (StartUp: the start-up line)
-    Curve curve;       // Contour: its offset
-    double u_start;    // Contour: where the offset starts after the previous corner
-    Move move;         // the block itself (side, radius, plane, tag, rapid)
-    SourceTag on_tag;  // the block that switched compensation (or its side) on
+    Segment seg;                     // the programmed move (StartUp: the start-up line)
+    Curve curve;                     // Contour: its offset
+    double u_start = 0;              // Contour: where the offset starts after the previous corner
+    Move move;                       // the block itself (side, radius, plane, tag, rapid)
+    SourceTag on_tag{};              // the block that switched compensation (or its side) on
+    std::deque<Recent> recent;       // the last contour moves, for the gouge check
+    std::optional<Recent> upcoming;  // the move being joined, while its corner is emitted
+
+    void become_contour(const Segment& s, const Curve& c, double u, const Move& m, SourceTag on,
+                        std::size_t window) {
+        kind = Kind::Contour;
+        seg = s;
+        curve = c;
+        u_start = u;
+        move = m;
+        on_tag = on;
+        upcoming.reset();
+        recent.push_back(Recent{s, m.tag});
+        while (recent.size() > window) recent.pop_front();
+    }
 };
 
 Compensator::Compensator(Config config, Vec2 start, double start_h)
@@ -231,8 +257,7 @@ void Compensator::finish_start_up(const Move& move) {
     emit_line(curve.at(0), pending_->seg.h1, pending_->move.rapid, Role::Startup,
               pending_->move.tag);
     flush_held();
-    const SourceTag on_tag = pending_->on_tag;
-    *pending_ = Pending{Pending::Kind::Contour, seg, curve, 0.0, move, on_tag};
+    pending_->become_contour(seg, curve, 0.0, move, pending_->on_tag, config_.gouge_check_moves);
 }
 
 void Compensator::link(const Move& move) {
@@ -240,13 +265,14 @@ void Compensator::link(const Move& move) {
     const SourceTag on_tag = move.side != pending_->move.side ? move.tag : pending_->on_tag;
     const Curve curve = offset_or_throw(seg, move, on_tag);
     emit_line(curve.at(0), seg.h0, move.rapid, Role::Startup, move.tag);
-    *pending_ = Pending{Pending::Kind::Contour, seg, curve, 0.0, move, on_tag};
+    pending_->become_contour(seg, curve, 0.0, move, on_tag, config_.gouge_check_moves);
 }
 
 void Compensator::join(const Move& move) {
     Pending& a = *pending_;
     const Segment seg = Segment::make(programmed_, programmed_h_, move);
     const Curve next = offset_or_throw(seg, move, a.on_tag);
+    a.upcoming = Pending::Recent{seg, move.tag};
     const Vec2 t_in = a.seg.tangent(1.0);
     const Vec2 t_out = seg.tangent(0.0);
     const double turn_sin = geom::cross(t_in, t_out);
@@ -293,8 +319,7 @@ void Compensator::join(const Move& move) {
         }
     }
     flush_held();
-    const SourceTag on_tag = a.on_tag;
-    *pending_ = Pending{Pending::Kind::Contour, seg, next, u_next, move, on_tag};
+    a.become_contour(seg, next, u_next, move, a.on_tag, config_.gouge_check_moves);
 }
 
 void Compensator::cancel(const Move& move) {
@@ -376,6 +401,28 @@ void Compensator::emit_line(const Vec2& to, double to_h, bool rapid, Role role, 
     tool_h_ = to_h;
 }
 
+void Compensator::check_gouge(const OutMove& piece, double radius_mm) const {
+    constexpr int kSamples = 64;
+    constexpr double kToleranceMm = 1e-6;
+    const double h_lo = std::min(piece.start_h, piece.end_h) - 1e-9;
+    const double h_hi = std::max(piece.start_h, piece.end_h) + 1e-9;
+    auto check = [&](const Pending::Recent& r) {
+        // Moves at other heights (a contour repeated deeper) are not in this layer.
+        if (std::max(r.seg.h0, r.seg.h1) < h_lo || std::min(r.seg.h0, r.seg.h1) > h_hi) return;
+        double nearest = radius_mm;
+        for (int i = 0; i <= kSamples; ++i)
+            nearest =
+                std::min(nearest, r.seg.distance(sample(piece, static_cast<double>(i) / kSamples)));
+        if (nearest < radius_mm - kToleranceMm)
+            throw CompError(fmt::format("cutter comp: gouge: the tool path of line {} comes within "
+                                        "{:.4g} of the contour of line {} (tool radius {:g})",
+                                        piece.tag, nearest, r.tag, radius_mm),
+                            r.tag, piece.tag);
+    };
+    for (const auto& r : pending_->recent) check(r);
+    if (pending_->upcoming) check(*pending_->upcoming);
+}
+
 void Compensator::emit_piece(OutMove piece, bool rapid, Role role, SourceTag tag) {
     const double length = piece.shape == Shape::Arc
                               ? (piece.start - piece.centre).norm() * piece.sweep_rad
@@ -385,6 +432,9 @@ void Compensator::emit_piece(OutMove piece, bool rapid, Role role, SourceTag tag
     piece.rapid = rapid;
     piece.role = role;
     piece.tag = tag;
+    if (pending_ && config_.gouge_check_moves > 0 &&
+        (role == Role::Contour || role == Role::Corner))
+        check_gouge(piece, pending_->move.radius_mm);
     out_.emplace_back(piece);
     tool_ = piece.end;
     tool_h_ = piece.end_h;

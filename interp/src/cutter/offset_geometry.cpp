@@ -1,5 +1,6 @@
 #include "offset_geometry.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -67,6 +68,18 @@ Vec2 Segment::tangent(double u) const {
 Vec2 Segment::point(double u) const {
     if (shape == Shape::Line) return start + (end - start) * u;
     return centre + radius * unit_at(start_angle + direction(ccw) * sweep * u);
+}
+
+double Segment::distance(const Vec2& p) const {
+    if (shape == Shape::Line) {
+        const Vec2 d = end - start;
+        const double len2 = d.squaredNorm();
+        const double t = len2 > 0 ? std::clamp((p - start).dot(d) / len2, 0.0, 1.0) : 0.0;
+        return (p - (start + d * t)).norm();
+    }
+    const double a = wrap_positive(direction(ccw) * (angle_of(p - centre) - start_angle));
+    if (a <= sweep) return std::abs((p - centre).norm() - radius);
+    return std::min((p - start).norm(), (p - end).norm());
 }
 
 Vec2 Curve::at(double u) const {

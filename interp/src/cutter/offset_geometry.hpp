@@ -29,6 +29,8 @@ struct Segment {
     bool degenerate() const;
     Vec2 tangent(double u) const;  // unit
     Vec2 point(double u) const;
+    /// Exact distance from p to the segment (not to its line or full circle).
+    double distance(const Vec2& p) const;
 };
 
 /// The offset of a Segment by a signed distance (+ left of travel, − right).
