@@ -84,23 +84,24 @@ TEST(CannedCycle, G83ReturnsToRAfterEveryPeck) {
 
 TEST(CannedCycle, G74TapsLeftHandWithReversalsAndDwells) {
     // 3) G01 to Z 4) dwell P, reverse 5) G01 to R 6) dwell P, reverse 7) G00 to
-    // the initial level (G98 here).
+    // the initial level (G98 here). Tapping feeds lock the feed override (G74-2).
     Session s;
     s.ctx.spindle = Spindle::Ccw;
     EXPECT_EQ(s.run(CycleCode::G74, Words().x(5).y(5).z(-10).r(-5).p(2000)),
-              (Lines{"rapid X5 Y5 Z10", "rapid X5 Y5 Z-5", "feed X5 Y5 Z-10 F800", "dwell 2s",
-                     "spindle reverse", "feed X5 Y5 Z-5 F800", "dwell 2s", "spindle reverse",
-                     "rapid X5 Y5 Z10"}));
+              (Lines{"rapid X5 Y5 Z10", "rapid X5 Y5 Z-5", "feed X5 Y5 Z-10 F800 locked",
+                     "dwell 2s", "spindle reverse", "feed X5 Y5 Z-5 F800 locked", "dwell 2s",
+                     "spindle reverse", "rapid X5 Y5 Z10"}));
 }
 
 TEST(CannedCycle, G84UsesTheTappingSpeedParameterAndRestoresS) {
     Session s;
     s.ctx.return_to_r = true;
     s.cfg.tap_spindle_rpm = 300;
-    EXPECT_EQ(s.run(CycleCode::G84, Words().x(5).y(5).z(-10).r(-5).p(2000)),
-              (Lines{"rapid X5 Y5 Z10", "rapid X5 Y5 Z-5", "spindle speed S300",
-                     "feed X5 Y5 Z-10 F800", "dwell 2s", "spindle reverse", "feed X5 Y5 Z-5 F800",
-                     "dwell 2s", "spindle reverse", "spindle speed S600"}));
+    EXPECT_EQ(
+        s.run(CycleCode::G84, Words().x(5).y(5).z(-10).r(-5).p(2000)),
+        (Lines{"rapid X5 Y5 Z10", "rapid X5 Y5 Z-5", "spindle speed S300",
+               "feed X5 Y5 Z-10 F800 locked", "dwell 2s", "spindle reverse",
+               "feed X5 Y5 Z-5 F800 locked", "dwell 2s", "spindle reverse", "spindle speed S600"}));
 }
 
 TEST(CannedCycle, TappingNeedsTheMatchingSpindleDirection) {
@@ -260,9 +261,10 @@ TEST(CycleData, ManualExample4LeftHandTappingL2) {
     for (const char* x : {"X15", "X65"}) {
         const std::string xy = std::string(x) + " Y15";
         for (const std::string& line :
-             {"rapid " + xy + " Z0", "rapid " + xy + " Z-5", "feed " + xy + " Z-33 F1000",
-              std::string("dwell 1s"), std::string("spindle reverse"), "feed " + xy + " Z-5 F1000",
-              std::string("dwell 1s"), std::string("spindle reverse"), "rapid " + xy + " Z0"})
+             {"rapid " + xy + " Z0", "rapid " + xy + " Z-5", "feed " + xy + " Z-33 F1000 locked",
+              std::string("dwell 1s"), std::string("spindle reverse"),
+              "feed " + xy + " Z-5 F1000 locked", std::string("dwell 1s"),
+              std::string("spindle reverse"), "rapid " + xy + " Z0"})
             expected.push_back(line);
     }
     EXPECT_EQ(s.run(CycleCode::G74, Words().x(50).y(0).z(-28).r(-5).p(1000).k(2)), expected);

@@ -44,6 +44,7 @@ struct Rapid {
 struct Feed {
     Vec3 to_mm;
     double feed_mm_min;
+    bool override_locked = false;  // tapping: feed override 100 %, feed hold waits (G74-2)
 };
 struct Dwell {
     double seconds;

@@ -24,6 +24,12 @@ class Emitter {
 
     void rapid_to_level(double c_mm) { move_level(c_mm, true); }
     void feed_to_level(double c_mm) { move_level(c_mm, false); }
+    /// A tapping move: the feed must stay locked to the spindle.
+    void tap_to_level(double c_mm) {
+        lock_override_ = true;
+        move_level(c_mm, false);
+        lock_override_ = false;
+    }
 
     /// Moves in the positioning plane at the current drilling-axis level.
     void rapid_in_plane(double a_mm, double b_mm) {
@@ -55,13 +61,14 @@ class Emitter {
         if (rapid)
             out_.steps.emplace_back(Rapid{to});
         else
-            out_.steps.emplace_back(Feed{to, hole_.feed_mm_min});
+            out_.steps.emplace_back(Feed{to, hole_.feed_mm_min, lock_override_});
         pos_ = to;
     }
 
     const HoleSpec& hole_;
     Vec3& pos_;
     Expansion& out_;
+    bool lock_override_ = false;
 };
 
 // G98 never returns below R: a cycle started with the tool under the R plane
@@ -140,10 +147,10 @@ void tap(const HoleSpec& h, const CycleConfig& cfg, const BlockContext& ctx, Emi
                         required == Spindle::Cw ? "clockwise" : "counter-clockwise", m_code));
     approach(h, e);
     if (cfg.tap_spindle_rpm) e.push(SpindleSpeed{*cfg.tap_spindle_rpm});
-    e.feed_to_level(h.z_mm);
+    e.tap_to_level(h.z_mm);
     e.dwell();
     e.push(SpindleReverse{});
-    e.feed_to_level(h.r_mm);
+    e.tap_to_level(h.r_mm);
     e.dwell();
     e.push(SpindleReverse{});
     if (cfg.tap_spindle_rpm) e.push(SpindleSpeed{h.spindle_rpm});

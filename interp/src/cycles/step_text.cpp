@@ -14,7 +14,8 @@ std::string xyz(const Vec3& p) {
 struct StepText {
     std::string operator()(const Rapid& s) const { return "rapid " + xyz(s.to_mm); }
     std::string operator()(const Feed& s) const {
-        return fmt::format("feed {} F{:g}", xyz(s.to_mm), s.feed_mm_min);
+        return fmt::format("feed {} F{:g}{}", xyz(s.to_mm), s.feed_mm_min,
+                           s.override_locked ? " locked" : "");
     }
     std::string operator()(const Dwell& s) const { return fmt::format("dwell {:g}s", s.seconds); }
     std::string operator()(const SpindleStop&) const { return "spindle stop"; }
