@@ -1,0 +1,288 @@
+#include "hal/script.hpp"
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <INIReader.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <fstream>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "hal/types.hpp"
+
+namespace hal {
+
+class IniFile {
+public:
+    explicit IniFile(const std::string& path) : path_(path), reader_(path) {
+        if (reader_.ParseError() < 0) throw Error(fmt::format("cannot open INI file '{}'", path));
+        if (reader_.ParseError() > 0)
+            throw Error(fmt::format("{}:{}: INI syntax error", path, reader_.ParseError()));
+    }
+    std::optional<std::string> get(const std::string& section, const std::string& key) const {
+        if (!reader_.HasValue(section, key)) return std::nullopt;
+        // A repeated key (several HALFILE=) reads as lines; substitution takes the first.
+        auto v = reader_.Get(section, key, "");
+        return v.substr(0, v.find('\n'));
+    }
+    const std::string& path() const { return path_; }
+
+private:
+    std::string path_;
+    INIReader reader_;
+};
+
+Script::Script(Backend& backend) : backend_(backend) {}
+Script::~Script() = default;
+
+void Script::load_ini(const std::string& path) { ini_ = std::make_unique<IniFile>(path); }
+
+std::string Script::substitute(const std::string& line) const {
+    std::string out;
+    for (std::size_t i = 0; i < line.size();) {
+        char c = line[i];
+        if (c == '[') {
+            auto close = line.find(']', i);
+            std::size_t key_end = close == std::string::npos ? close : close + 1;
+            while (key_end != std::string::npos && key_end < line.size() &&
+                   (std::isalnum(static_cast<unsigned char>(line[key_end])) || line[key_end] == '_' ||
+                    line[key_end] == '-' || line[key_end] == '.'))
+                ++key_end;
+            if (close != std::string::npos && key_end > close + 1) {
+                auto section = line.substr(i + 1, close - i - 1);
+                auto key = line.substr(close + 1, key_end - close - 1);
+                if (!ini_)
+                    throw Error(fmt::format("[{}]{} needs an INI file (halrun -i FILE)", section, key));
+                auto v = ini_->get(section, key);
+                if (!v) throw Error(fmt::format("[{}]{} is not in INI file '{}'", section, key, ini_->path()));
+                out += *v;
+                i = key_end;
+                continue;
+            }
+        }
+        if (c == '$' && i + 1 < line.size()) {
+            std::size_t start = i + 1, end;
+            bool paren = line[start] == '(';
+            if (paren) {
+                end = line.find(')', start);
+                if (end == std::string::npos) throw Error("unterminated $( in line");
+                ++start;
+            } else {
+                end = start;
+                while (end < line.size() && (std::isalnum(static_cast<unsigned char>(line[end])) || line[end] == '_'))
+                    ++end;
+            }
+            auto var = line.substr(start, end - start);
+            if (!var.empty()) {
+                const char* v = std::getenv(var.c_str());
+                if (!v) throw Error(fmt::format("environment variable '{}' is not set", var));
+                out += v;
+                i = paren ? end + 1 : end;
+                continue;
+            }
+        }
+        out += c;
+        ++i;
+    }
+    return out;
+}
+
+std::vector<std::string> Script::tokenize(const std::string& raw) const {
+    // Comments go before substitution so a '#' inside an INI value is kept.
+    std::string line;
+    bool quoted = false;
+    for (std::size_t i = 0; i < raw.size(); ++i) {
+        char c = raw[i];
+        if (c == '"') quoted = !quoted;
+        if (c == '#' && !quoted && (i == 0 || std::isspace(static_cast<unsigned char>(raw[i - 1])))) break;
+        line += c;
+    }
+    if (quoted) throw Error("unterminated quote");
+    line = substitute(line);
+    std::vector<std::string> words;
+    std::string word;
+    bool in_word = false;
+    quoted = false;
+    for (char c : line) {
+        if (c == '"') {
+            quoted = !quoted;
+            in_word = true;
+            continue;
+        }
+        if (!quoted && std::isspace(static_cast<unsigned char>(c))) {
+            if (in_word) words.push_back(word);
+            word.clear();
+            in_word = false;
+            continue;
+        }
+        word += c;
+        in_word = true;
+    }
+    if (in_word) words.push_back(word);
+    return words;
+}
+
+void Script::run_words(const std::vector<std::string>& words, std::string& out) {
+    const std::string& cmd = words[0];
+    if (cmd == "echo") {
+        std::vector<std::string> rest(words.begin() + 1, words.end());
+        out += fmt::format("{}\n", fmt::join(rest, " "));
+    } else if (cmd == "source") {
+        if (words.size() != 2) throw Error("usage: source FILE");
+        if (!run_file(words[1])) throw Error(fmt::format("sourced file '{}' failed", words[1]));
+    } else if (cmd == "loadusr") {
+        cmd_loadusr(words);
+    } else if (cmd == "waitusr") {
+        cmd_waitusr(words);
+    } else {
+        backend_.exec(words, out);
+    }
+}
+
+bool Script::run_line(const std::string& text, const std::string& where, int line) {
+    std::string out;
+    try {
+        auto words = tokenize(text);
+        if (words.empty()) return true;
+        run_words(words, out);
+        fmt::print("{}", out);
+        std::fflush(stdout);
+        return true;
+    } catch (const Error& e) {
+        fmt::print("{}", out);
+        std::fflush(stdout);
+        if (line > 0) fmt::print(stderr, "{}:{}: {}\n", where, line, e.what());
+        else fmt::print(stderr, "{}: {}\n", where, e.what());
+        return false;
+    }
+}
+
+bool Script::run_file(const std::string& path) {
+    if (std::find(file_stack_.begin(), file_stack_.end(), path) != file_stack_.end()) {
+        fmt::print(stderr, "{}: sourced from itself\n", path);
+        return false;
+    }
+    std::ifstream in(path);
+    if (!in) {
+        fmt::print(stderr, "{}: cannot open: {}\n", path, std::strerror(errno));
+        return false;
+    }
+    file_stack_.push_back(path);
+    std::string physical, logical;
+    int line_no = 0, first_line = 0;
+    bool ok = true;
+    while (ok && std::getline(in, physical)) {
+        ++line_no;
+        if (logical.empty()) first_line = line_no;
+        if (!physical.empty() && physical.back() == '\r') physical.pop_back();
+        if (!physical.empty() && physical.back() == '\\') {
+            logical += physical.substr(0, physical.size() - 1) + " ";
+            continue;
+        }
+        logical += physical;
+        ok = run_line(logical, path, first_line);
+        logical.clear();
+    }
+    if (ok && !logical.empty()) ok = run_line(logical, path, first_line);
+    file_stack_.pop_back();
+    return ok;
+}
+
+void Script::cmd_loadusr(const std::vector<std::string>& words) {
+    bool wait_ready = false, wait_exit = false, ignore_status = false;
+    std::string name;
+    std::size_t i = 1;
+    for (; i < words.size() && words[i].size() > 1 && words[i][0] == '-'; ++i) {
+        const auto& opt = words[i];
+        if (opt == "-W") wait_ready = true;
+        else if (opt == "-w") wait_exit = true;
+        else if (opt == "-i") ignore_status = true;
+        else if (opt == "-Wn" || opt == "-n") {
+            wait_ready = wait_ready || opt == "-Wn";
+            if (++i >= words.size()) throw Error(fmt::format("{} needs a component name", opt));
+            name = words[i];
+        } else {
+            throw Error(fmt::format("loadusr: unknown option '{}' (-W, -w, -i, -n NAME, -Wn NAME)", opt));
+        }
+    }
+    if (i >= words.size()) throw Error("usage: loadusr [-W|-w|-i|-Wn NAME] PROGRAM [ARGS...]");
+    std::vector<std::string> argv(words.begin() + static_cast<long>(i), words.end());
+    if (name.empty()) {
+        name = argv[0].substr(argv[0].rfind('/') + 1);
+    }
+    std::fflush(stdout);
+    std::fflush(stderr);
+    pid_t pid = ::fork();
+    if (pid < 0) throw Error(fmt::format("loadusr: fork failed: {}", std::strerror(errno)));
+    if (pid == 0) {
+        std::vector<char*> args;
+        for (auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+        args.push_back(nullptr);
+        ::execvp(args[0], args.data());
+        fmt::print(stderr, "loadusr: cannot run '{}': {}\n", argv[0], std::strerror(errno));
+        ::_exit(127);
+    }
+    children_[name] = pid;
+    auto wait_child = [&]() -> int {
+        int status = 0;
+        while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+        }
+        children_.erase(name);
+        return status;
+    };
+    if (wait_exit) {
+        int status = wait_child();
+        if (!ignore_status && (!WIFEXITED(status) || WEXITSTATUS(status) != 0))
+            throw Error(fmt::format("loadusr: '{}' failed ({})", argv[0],
+                                    WIFEXITED(status) ? fmt::format("exit status {}", WEXITSTATUS(status))
+                                                      : fmt::format("signal {}", WTERMSIG(status))));
+        return;
+    }
+    if (wait_ready) {
+        using namespace std::chrono;
+        auto deadline = steady_clock::now() + seconds(30);
+        while (!backend_.component_ready(name)) {
+            int status = 0;
+            if (::waitpid(pid, &status, WNOHANG) == pid) {
+                children_.erase(name);
+                throw Error(fmt::format("loadusr: '{}' exited before component '{}' became ready", argv[0], name));
+            }
+            if (steady_clock::now() > deadline) {
+                throw Error(fmt::format("loadusr: component '{}' not ready after 30 s", name));
+            }
+            std::this_thread::sleep_for(milliseconds(5));
+        }
+    }
+}
+
+void Script::cmd_waitusr(const std::vector<std::string>& words) {
+    if (words.size() != 2) throw Error("usage: waitusr COMPONENT");
+    auto& name = words[1];
+    if (auto it = children_.find(name); it != children_.end()) {
+        int status = 0;
+        while (::waitpid(it->second, &status, 0) < 0 && errno == EINTR) {
+        }
+        children_.erase(it);
+        return;
+    }
+    if (!backend_.component_exists(name)) throw Error(fmt::format("waitusr: no component '{}'", name));
+    while (backend_.component_exists(name)) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+}
+
+void Script::terminate_children() {
+    for (auto& [name, pid] : children_) ::kill(pid, SIGTERM);
+    for (auto& [name, pid] : children_) {
+        int status;
+        ::waitpid(pid, &status, 0);
+    }
+    children_.clear();
+}
+
+}  // namespace hal
