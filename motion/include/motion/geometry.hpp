@@ -1,0 +1,74 @@
+// Path elements the planner strings together: straight lines, circular arcs/helices, and the
+// corner blends it inserts between lines. Each element is a curve p(s) over s in [0, length_mm];
+// for lines and arcs s is the arc length, for blends it is a pseudo length with |p'(s)| <= 1, so
+// the path speed never exceeds ds/dt.
+//
+// Corner blend (G64 P): a quartic curve from the point `l` before the corner to the point `l`
+// after it whose tangent turns from T1 to T2 as sigma(u) = 3u^2 - 2u^3, u = s / 2l:
+//
+//        T1             corner
+//   ----------->--------+            p'(s)   = T1 + sigma(u) (T2 - T1)
+//                 \_    |            p''(s)  = sigma'(u) (T2 - T1) / 2l    (zero at both ends)
+//                   \   | T2         p'''(s) = sigma''(u) (T2 - T1) / 4l^2
+//                    \  v
+// Curvature is zero at both ends, so a blend joins its lines without an acceleration step, and
+// the largest distance from the programmed corner lines is (3/16) l sin(angle).
+#pragma once
+
+#include <cstdint>
+
+#include "motion/types.hpp"
+
+namespace motion {
+
+enum class ElementKind : std::uint8_t { Line, Arc, Blend };
+
+// Trivially copyable: it travels inside PreparedSegment through the realtime ring.
+struct Element {
+    ElementKind kind = ElementKind::Line;
+    double length_mm = 0;
+    AxisArray origin{};  // line: start; arc: centre with the start's off-plane values; blend: start
+    AxisArray a{};       // line: unit direction; arc: in-plane unit u; blend: T1
+    AxisArray b{};       // arc: in-plane unit w (u x w = normal); blend: T2 - T1
+    AxisArray c{};       // arc: linear displacement of the off-plane axes over the whole arc
+    AxisArray end{};     // exact programmed end, returned at s = length
+    double radius_mm = 0;
+    double theta0_rad = 0;
+    double sweep_rad = 0;  // signed, positive counter-clockwise from u towards w
+};
+
+// Position and its first three derivatives with respect to s.
+struct CurvePoint {
+    AxisArray p{}, d1{}, d2{}, d3{};
+};
+
+// Realtime-safe: noexcept, no allocation, constant time.
+void evaluate(const Element& e, double s_mm, CurvePoint& out) noexcept;
+
+// Per-axis bounds over the whole element: |p'_k| <= g1[k], |p''_k| <= g2[k], |p'''_k| <= g3[k].
+// For arcs, `tangential_in_plane[k]` and `linear[k]` split g1 so that the planner can use the
+// exact (rotating-vector) combination of tangential and centripetal acceleration.
+struct ElementBounds {
+    AxisArray g1{}, g2{}, g3{};
+    AxisArray tangential_in_plane{}, linear{};
+};
+ElementBounds bounds(const Element& e) noexcept;
+
+Element make_line(const AxisArray& start, const AxisArray& end) noexcept;
+// Throws PlanError for a zero radius, an end off the circle, a bad plane or zero turns.
+Element make_arc(const AxisArray& start, const PathSegment& seg);
+// t1, t2 unit tangents at the corner, `l` the distance cut from each side.
+Element make_blend(const AxisArray& corner, const AxisArray& t1, const AxisArray& t2,
+                   double l_mm) noexcept;
+
+// Unit tangent and second derivative at the element's start (s = 0) and end (s = length).
+struct EndDerivs {
+    AxisArray tangent{}, d2{};
+};
+EndDerivs start_derivs(const Element& e) noexcept;
+EndDerivs end_derivs(const Element& e) noexcept;
+
+// The line element trimmed to [from_mm, length - to_mm] of the original.
+Element trim_line(const Element& line, double from_mm, double to_mm) noexcept;
+
+}  // namespace motion

@@ -1,0 +1,109 @@
+// Non-realtime look-ahead planner: turns a stream of PathSegments into PreparedSegments.
+//
+// Flow of one move:
+//   push(segment) -> geometry (line / arc element; a corner blend is inserted between two lines
+//   when the tolerance allows, see geometry.hpp) -> per-element limits (limits.hpp) -> window.
+//   When the window holds `window` elements, a backward pass (from a stop at the window's end)
+//   and a forward pass (from the fixed speed where the last emitted record ended) give each
+//   junction the highest speed that is both reachable and stoppable; the first half of the
+//   window is then emitted as prepared records with their 1-D profiles. finish() emits the rest,
+//   ending at rest. Because every plan ends in a stop at the window's end, anything emitted is
+//   safe whatever arrives later; later segments can only raise the speeds still to be planned.
+//
+// Limit sharing: elements use (1 - override_reserve) of each axis's acceleration and jerk; the
+// reserve is what the sampler needs to change the time scale (override, hold, abort) without
+// exceeding the limits. Elements next to a junction that is not smooth (a tiny kink, or a
+// curvature step under a jerk limit) also give up `junction_share`: such a junction is passed at
+// a speed where the step is at most junction_share * limit over one servo period.
+//
+// Not thread-safe; one planner per motion queue. Throws PlanError on bad input; a rejected
+// segment changes nothing.
+#pragma once
+
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include "motion/limits.hpp"
+#include "motion/prepared.hpp"
+#include "motion/types.hpp"
+
+namespace motion {
+
+struct PlannerConfig {
+    AxisLimits limits;
+    double servo_period_s = 1e-3;
+    double override_reserve = 0.1;  // share of acc/jerk kept for time scaling in the sampler
+    double junction_share = 0.1;    // share of acc/jerk a non-smooth junction may take
+    double max_rate = 1.2;          // highest feed override the sampler will apply
+    std::size_t window = 4096;      // look-ahead length in elements
+};
+
+// Throws std::invalid_argument naming the bad field.
+void validate(const PlannerConfig& cfg);
+
+class Planner {
+  public:
+    Planner(const PlannerConfig& cfg, const AxisArray& start_mm);
+
+    void push(const PathSegment& seg);
+    // End of the program (or a point where the machine must come to rest): plans and emits
+    // everything, the last record ending at rest with program_end set.
+    void finish();
+    // Forget everything (after an abort) and start again from start_mm.
+    void reset(const AxisArray& start_mm);
+
+    std::size_t ready() const noexcept { return out_.size() - out_head_; }
+    bool pop(PreparedSegment& out) noexcept;
+    // Copies up to out.size() ready records; returns how many.
+    std::size_t take(std::span<PreparedSegment> out) noexcept;
+
+    const AxisArray& end_position() const noexcept { return last_end_; }
+    const PlannerConfig& config() const noexcept { return cfg_; }
+
+  private:
+    struct Piece {
+        Element geom;
+        double feed_mm_s;  // 0 = rapid
+        double tolerance_mm;
+        bool exact_stop;
+        std::int32_t line;
+        double trim_start_mm = 0;
+        bool rough_start = false;  // the junction at its start is not smooth
+    };
+    struct Item {
+        Element geom;
+        ElementLimits lim;
+        LimitShares share;
+        double end_cap_mm_s;  // junction speed limit at its end
+        bool rough;           // next to a junction that is not smooth
+        std::int32_t line;
+    };
+    struct Junction {
+        double cap_mm_s;
+        bool rough;
+        double blend_l_mm;  // > 0: insert a blend cutting this much from both sides
+    };
+
+    Junction classify(const Piece& p, const Piece& next) const;
+    void close_piece(Piece& p, Piece* next);
+    void add_item(const Element& e, double feed, double end_cap, bool rough, std::int32_t line);
+    std::size_t plan_and_emit(bool all);  // returns how many records it emitted
+    void emit(const Item& it, double v_in, double v_out);
+    double junction_bound(std::size_t i) const;
+
+    PlannerConfig cfg_;
+    AxisArray last_end_;
+    bool have_pending_ = false;
+    Piece pending_{};
+    std::vector<Item> items_;
+    std::size_t head_ = 0;
+    double v_start_ = 0;
+    std::vector<double> vj_;
+    std::vector<PreparedSegment> out_;
+    std::size_t out_head_ = 0;
+    std::uint32_t seq_ = 0;
+    bool jerk_mode_ = false;
+};
+
+}  // namespace motion

@@ -1,0 +1,87 @@
+// Realtime side: samples prepared records once per servo period, applying feed override,
+// feed hold and abort by scaling time.
+//
+// The sampler keeps its own clock tau in planned time and a rate r = d tau / dt (1 = as
+// planned, 0 = stopped). With planned axis velocity v, acceleration a and jerk j at tau, the
+// commanded motion is
+//     velocity v r,   acceleration a r^2 + v r',   jerk j r^3 + 3 a r r' + v r''.
+// The planner leaves `override_reserve` of each axis's acceleration and jerk unused, and the
+// rate follows its target with |r'| and |r''| small enough that the r', r'' terms fit in that
+// reserve; above r = 1 each record's rate_cap keeps a r^2 and j r^3 within the rest. So any
+// override in [0, max_rate], any hold and any abort keeps every axis within its limits; a hold
+// or abort from full speed takes about 1 / r'max seconds (see rate_limits()).
+//
+// Everything on this class is realtime-safe (noexcept, no allocation, bounded time) except
+// the constructor. One thread drives advance(); the controls may be called from the same thread.
+#pragma once
+
+#include <cstddef>
+
+#include "motion/planner.hpp"
+#include "motion/prepared.hpp"
+#include "motion/spsc_ring.hpp"
+#include "motion/types.hpp"
+
+namespace motion {
+
+struct SamplerConfig {
+    AxisLimits limits;
+    double override_reserve = 0.1;        // must equal the planner's
+    double max_rate = 1.2;                // must equal the planner's
+    std::size_t lookahead_records = 512;  // most records scanned for rate caps per period
+};
+SamplerConfig sampler_config(const PlannerConfig& p);
+
+struct RateLimits {
+    double max_rate_per_s = 0;   // |r'|
+    double max_rate_per_s2 = 0;  // |r''|
+};
+// The largest |r'| and |r''| that fit in the reserve for these limits.
+RateLimits rate_limits(const SamplerConfig& cfg) noexcept;
+
+struct SamplerStatus {
+    bool moving = false;   // rate > 0 and a record is being followed
+    bool done = false;     // at the end of a program_end record, nothing queued
+    bool starved = false;  // ran out of records before a program_end: the producer fell behind
+    bool held = false;     // hold requested and the rate has reached 0
+    bool aborted = false;  // abort requested and the rate has reached 0; queue being discarded
+    double rate = 0;       // current time scale r
+};
+
+class Sampler {
+  public:
+    Sampler(const SamplerConfig& cfg, SpscRing<PreparedSegment>& ring, const AxisArray& start_mm);
+
+    void set_feed_override(double scale) noexcept;  // clamped to [0, max_rate]
+    void set_hold(bool on) noexcept;
+    void abort() noexcept;
+    // After an abort has stopped: accept records again (the owner resets the planner first).
+    void clear_abort() noexcept;
+
+    // Advances wall time by dt_s and returns the commanded motion at the new time.
+    MotionSample advance(double dt_s) noexcept;
+
+    const SamplerStatus& status() const noexcept { return status_; }
+
+  private:
+    double rate_target() const noexcept;
+    double rate_cap_ahead() const noexcept;
+    double integrate_rate(double target, double dt) noexcept;
+    void consume_finished_records() noexcept;
+
+    SamplerConfig cfg_;
+    RateLimits rl_;
+    SpscRing<PreparedSegment>& ring_;
+    MotionSample last_{};
+    double tau_ = 0;  // planned time within the front record
+    double r_ = 1;    // rate
+    double rd_ = 0;   // d rate / dt
+    double rdd_ = 0;  // d^2 rate / dt^2 in effect
+    double override_ = 1;
+    bool hold_ = false;
+    bool abort_ = false;
+    bool jerk_limited_ = false;
+    SamplerStatus status_{};
+};
+
+}  // namespace motion

@@ -1,0 +1,214 @@
+#include "motion/geometry.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+namespace motion {
+namespace {
+
+constexpr double kTwoPi = 2 * std::numbers::pi;
+
+double norm(const AxisArray& v) {
+    double s = 0;
+    for (double x : v) s += x * x;
+    return std::sqrt(s);
+}
+
+void eval_line(const Element& e, double s, CurvePoint& out) {
+    for (int k = 0; k < kAxes; ++k) {
+        out.p[k] = e.origin[k] + s * e.a[k];
+        out.d1[k] = e.a[k];
+        out.d2[k] = 0;
+        out.d3[k] = 0;
+    }
+}
+
+void eval_arc(const Element& e, double s, CurvePoint& out) {
+    double k1 = e.sweep_rad / e.length_mm;  // d theta / ds
+    double th = e.theta0_rad + k1 * s;
+    double cs = std::cos(th), sn = std::sin(th);
+    double r = e.radius_mm, f = s / e.length_mm;
+    for (int k = 0; k < kAxes; ++k) {
+        double radial = cs * e.a[k] + sn * e.b[k];
+        double tang = -sn * e.a[k] + cs * e.b[k];
+        out.p[k] = e.origin[k] + r * radial + f * e.c[k];
+        out.d1[k] = r * k1 * tang + e.c[k] / e.length_mm;
+        out.d2[k] = -r * k1 * k1 * radial;
+        out.d3[k] = -r * k1 * k1 * k1 * tang;
+    }
+}
+
+void eval_blend(const Element& e, double s, CurvePoint& out) {
+    double two_l = e.length_mm;
+    double u = s / two_l;
+    double sigma = u * u * (3 - 2 * u);
+    double integral = u * u * u * (1 - u / 2);  // int_0^u sigma
+    double dsigma = 6 * u * (1 - u) / two_l;
+    double ddsigma = (6 - 12 * u) / (two_l * two_l);
+    for (int k = 0; k < kAxes; ++k) {
+        out.p[k] = e.origin[k] + two_l * (u * e.a[k] + integral * e.b[k]);
+        out.d1[k] = e.a[k] + sigma * e.b[k];
+        out.d2[k] = dsigma * e.b[k];
+        out.d3[k] = ddsigma * e.b[k];
+    }
+}
+
+}  // namespace
+
+void evaluate(const Element& e, double s, CurvePoint& out) noexcept {
+    s = std::clamp(s, 0.0, e.length_mm);
+    switch (e.kind) {
+        case ElementKind::Line:
+            eval_line(e, s, out);
+            break;
+        case ElementKind::Arc:
+            eval_arc(e, s, out);
+            break;
+        case ElementKind::Blend:
+            eval_blend(e, s, out);
+            break;
+    }
+    if (s >= e.length_mm) out.p = e.end;  // the programmed end point, free of rounding
+}
+
+ElementBounds bounds(const Element& e) noexcept {
+    ElementBounds b;
+    switch (e.kind) {
+        case ElementKind::Line:
+            for (int k = 0; k < kAxes; ++k) b.g1[k] = b.linear[k] = std::fabs(e.a[k]);
+            break;
+        case ElementKind::Arc: {
+            double k1 = std::fabs(e.sweep_rad / e.length_mm);
+            double r = e.radius_mm;
+            for (int k = 0; k < kAxes; ++k) {
+                double q = std::hypot(e.a[k], e.b[k]);  // amplitude of the rotating component
+                b.tangential_in_plane[k] = r * k1 * q;
+                b.linear[k] = std::fabs(e.c[k]) / e.length_mm;
+                b.g1[k] = b.tangential_in_plane[k] + b.linear[k];
+                b.g2[k] = r * k1 * k1 * q;
+                b.g3[k] = r * k1 * k1 * k1 * q;
+            }
+            break;
+        }
+        case ElementKind::Blend: {
+            double two_l = e.length_mm;
+            for (int k = 0; k < kAxes; ++k) {
+                double t2 = e.a[k] + e.b[k];
+                b.g1[k] = b.linear[k] = std::max(std::fabs(e.a[k]), std::fabs(t2));
+                b.g2[k] = 1.5 * std::fabs(e.b[k]) / two_l;
+                b.g3[k] = 6 * std::fabs(e.b[k]) / (two_l * two_l);
+            }
+            break;
+        }
+    }
+    return b;
+}
+
+Element make_line(const AxisArray& start, const AxisArray& end) noexcept {
+    Element e;
+    e.kind = ElementKind::Line;
+    AxisArray d;
+    for (int k = 0; k < kAxes; ++k) d[k] = end[k] - start[k];
+    e.length_mm = norm(d);
+    e.origin = start;
+    e.end = end;
+    for (int k = 0; k < kAxes; ++k) e.a[k] = e.length_mm > 0 ? d[k] / e.length_mm : 0;
+    return e;
+}
+
+Element make_arc(const AxisArray& start, const PathSegment& seg) {
+    int i = seg.plane_first, j = seg.plane_second, n = seg.plane_normal;
+    auto valid = [](int ax) { return ax >= 0 && ax < kAxes; };
+    if (!valid(i) || !valid(j) || !valid(n) || i == j || i == n || j == n)
+        throw PlanError(seg.line, "arc plane axes must be three different axes");
+    if (seg.turns == 0) throw PlanError(seg.line, "arc with zero turns");
+    double cu = seg.centre_mm[0], cv = seg.centre_mm[1];
+    double su = start[i] - cu, sv = start[j] - cv;
+    double eu = seg.end_mm[i] - cu, ev = seg.end_mm[j] - cv;
+    double r0 = std::hypot(su, sv), r1 = std::hypot(eu, ev);
+    if (r0 < 1e-9) throw PlanError(seg.line, "arc radius is zero (centre at the start point)");
+    // LinuxCNC-like acceptance: small rounding of the programmed end is absorbed by moving the
+    // centre onto the chord's perpendicular bisector; anything larger is a programming error.
+    double mismatch = std::fabs(r1 - r0);
+    if (mismatch > std::max(0.005, 1e-3 * r0))
+        throw PlanError(seg.line, "arc end is not on the circle: start radius " +
+                                      std::to_string(r0) + " mm, end radius " + std::to_string(r1) +
+                                      " mm");
+    double chord_u = seg.end_mm[i] - start[i], chord_v = seg.end_mm[j] - start[j];
+    double chord = std::hypot(chord_u, chord_v);
+    if (mismatch > 0 && chord > 1e-9) {
+        double mu = (start[i] + seg.end_mm[i]) / 2, mv = (start[j] + seg.end_mm[j]) / 2;
+        double nu = -chord_v / chord, nv = chord_u / chord;  // bisector direction
+        double t = (cu - mu) * nu + (cv - mv) * nv;
+        cu = mu + t * nu;
+        cv = mv + t * nv;
+        su = start[i] - cu, sv = start[j] - cv;
+        eu = seg.end_mm[i] - cu, ev = seg.end_mm[j] - cv;
+        r0 = std::hypot(su, sv);
+    }
+    double th0 = std::atan2(sv, su), th1 = std::atan2(ev, eu);
+    double sweep = th1 - th0;
+    int extra = std::abs(seg.turns) - 1;
+    if (seg.turns > 0) {
+        if (sweep <= 1e-12) sweep += kTwoPi;
+        sweep += kTwoPi * extra;
+    } else {
+        if (sweep >= -1e-12) sweep -= kTwoPi;
+        sweep -= kTwoPi * extra;
+    }
+    Element e;
+    e.kind = ElementKind::Arc;
+    e.origin = start;
+    e.origin[i] = cu;
+    e.origin[j] = cv;
+    e.a[i] = 1;
+    e.b[j] = 1;
+    for (int k = 0; k < kAxes; ++k) e.c[k] = (k == i || k == j) ? 0 : seg.end_mm[k] - start[k];
+    e.radius_mm = r0;
+    e.theta0_rad = th0;
+    e.sweep_rad = sweep;
+    e.length_mm = std::hypot(r0 * sweep, norm(e.c));
+    e.end = seg.end_mm;
+    return e;
+}
+
+Element make_blend(const AxisArray& corner, const AxisArray& t1, const AxisArray& t2,
+                   double l) noexcept {
+    Element e;
+    e.kind = ElementKind::Blend;
+    e.length_mm = 2 * l;
+    for (int k = 0; k < kAxes; ++k) {
+        e.origin[k] = corner[k] - l * t1[k];
+        e.a[k] = t1[k];
+        e.b[k] = t2[k] - t1[k];
+        e.end[k] = corner[k] + l * t2[k];
+    }
+    return e;
+}
+
+EndDerivs start_derivs(const Element& e) noexcept {
+    CurvePoint cp;
+    evaluate(e, 0, cp);
+    return {cp.d1, cp.d2};
+}
+
+EndDerivs end_derivs(const Element& e) noexcept {
+    CurvePoint cp;
+    evaluate(e, e.length_mm, cp);
+    return {cp.d1, cp.d2};
+}
+
+Element trim_line(const Element& line, double from, double to) noexcept {
+    Element e = line;
+    double len = line.length_mm;
+    for (int k = 0; k < kAxes; ++k) {
+        e.origin[k] = line.origin[k] + from * line.a[k];
+        if (to > 0) e.end[k] = line.end[k] - to * line.a[k];
+    }
+    e.length_mm = std::max(0.0, len - from - to);
+    return e;
+}
+
+}  // namespace motion

@@ -1,0 +1,100 @@
+#include "motion/limits.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace motion {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// Share of an axis's acceleration that centripetal acceleration may take; the rest is left
+// for speeding up and slowing down on curves. Blends are short, so their speed barely changes
+// inside them and almost all of it goes to turning.
+constexpr double kCentripetalShareArc = 0.8;
+constexpr double kCentripetalShareBlend = 0.95;
+// Shares of the jerk budget for the v^3 p''' and 3 v a p'' terms of curved elements.
+constexpr double kJerkCubicShare = 0.4;
+constexpr double kJerkCrossShare = 0.3;
+
+bool is_arc(const Element& e) {
+    return e.kind == ElementKind::Arc;
+}
+
+double speed_cap(const Element& e, const ElementBounds& b, const AxisLimits& lim, double feed,
+                 const LimitShares& share) {
+    double v = feed > 0 ? feed : kInf;
+    double centripetal = is_arc(e) ? kCentripetalShareArc : kCentripetalShareBlend;
+    for (int k = 0; k < kAxes; ++k) {
+        if (b.g1[k] > 0) v = std::min(v, lim.vel_mm_s[k] / b.g1[k]);
+        if (b.g2[k] > 0)
+            v = std::min(v, std::sqrt(centripetal * share.acc * lim.acc_mm_s2[k] / b.g2[k]));
+        if (b.g3[k] > 0 && lim.jerk_mm_s3[k] > 0)
+            v = std::min(v, std::cbrt(kJerkCubicShare * share.jerk * lim.jerk_mm_s3[k] / b.g3[k]));
+    }
+    return v;
+}
+
+// Largest a with sqrt((a t)^2 + n^2) + a l <= m: the in-plane part of an arc's acceleration is
+// a rotating vector, so tangential and centripetal parts add in quadrature, not linearly.
+double arc_axis_acc(double t, double l, double n, double m) {
+    if (t == 0 && l == 0) return kInf;
+    double lo = 0, hi = m / std::max(t, l);  // sqrt(.) >= a t and >= 0, so a <= m / max(t, l)
+    for (int i = 0; i < 50; ++i) {
+        double mid = (lo + hi) / 2;
+        (std::hypot(mid * t, n) + mid * l <= m ? lo : hi) = mid;
+    }
+    return lo;
+}
+
+double tangential_acc(const Element& e, const ElementBounds& b, const AxisLimits& lim, double v,
+                      const LimitShares& share) {
+    double a = kInf;
+    for (int k = 0; k < kAxes; ++k) {
+        double m = share.acc * lim.acc_mm_s2[k];
+        double n = v * v * b.g2[k];
+        if (is_arc(e)) {
+            a = std::min(a, arc_axis_acc(b.tangential_in_plane[k], b.linear[k], n, m));
+        } else if (b.g1[k] > 0) {
+            a = std::min(a, (m - n) / b.g1[k]);
+        }
+    }
+    return a;
+}
+
+}  // namespace
+
+ElementLimits element_limits(const Element& e, const ElementBounds& b, const AxisLimits& lim,
+                             double feed, const LimitShares& share) noexcept {
+    ElementLimits out;
+    double v = speed_cap(e, b, lim, feed, share);
+    double a = tangential_acc(e, b, lim, v, share);
+    double j = kInf;
+    for (int k = 0; k < kAxes; ++k) {
+        if (lim.jerk_mm_s3[k] <= 0) continue;
+        double m = share.jerk * lim.jerk_mm_s3[k];
+        if (b.g2[k] > 0) a = std::min(a, kJerkCrossShare * m / (3 * v * b.g2[k]));
+        if (b.g1[k] > 0) j = std::min(j, (m - 3 * v * a * b.g2[k] - v * v * v * b.g3[k]) / b.g1[k]);
+    }
+    out.vcap_mm_s = v;
+    out.tangent.acc_mm_s2 = a;
+    out.tangent.jerk_mm_s3 = std::isfinite(j) ? j : 0;
+    return out;
+}
+
+double rate_cap(const ElementBounds& b, const AxisLimits& lim, double v, double a, double j,
+                const LimitShares& share, double max_rate) noexcept {
+    double r = max_rate;
+    for (int k = 0; k < kAxes; ++k) {
+        double vk = v * b.g1[k];
+        double ak = a * b.g1[k] + v * v * b.g2[k];
+        double jk = j * b.g1[k] + 3 * v * a * b.g2[k] + v * v * v * b.g3[k];
+        if (vk > 0) r = std::min(r, lim.vel_mm_s[k] / vk);
+        if (ak > 0) r = std::min(r, std::sqrt(share.acc * lim.acc_mm_s2[k] / ak));
+        if (jk > 0 && lim.jerk_mm_s3[k] > 0)
+            r = std::min(r, std::cbrt(share.jerk * lim.jerk_mm_s3[k] / jk));
+    }
+    return std::max(r, 1.0);
+}
+
+}  // namespace motion

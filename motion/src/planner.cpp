@@ -1,0 +1,260 @@
+#include "motion/planner.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace motion {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kMinLength_mm = 1e-9;  // shorter moves are dropped as no motion
+constexpr double kTangentEps = 1e-12;   // max per-axis tangent difference treated as smooth
+// The blend's farthest point from the corner is (3/16) l |T2 - T1| (geometry.hpp).
+constexpr double kBlendDeviationPerL = 3.0 / 16.0;
+// A kink whose allowed speed is below this fraction of the feed is taken as an exact stop.
+constexpr double kKinkStopFraction = 0.02;
+
+bool finite_array(const AxisArray& a) {
+    return std::all_of(a.begin(), a.end(), [](double x) { return std::isfinite(x); });
+}
+
+void validate_segment(const PathSegment& seg) {
+    if (!finite_array(seg.end_mm)) throw PlanError(seg.line, "end point is not a finite number");
+    if (!seg.rapid && !(seg.feed_mm_s > 0 && std::isfinite(seg.feed_mm_s)))
+        throw PlanError(seg.line, "feed move needs a positive feed rate (got " +
+                                      std::to_string(seg.feed_mm_s) + " mm/s)");
+    if (!(seg.tolerance_mm >= 0)) throw PlanError(seg.line, "blend tolerance must be >= 0");
+    if (seg.kind == SegmentKind::Arc &&
+        !(std::isfinite(seg.centre_mm[0]) && std::isfinite(seg.centre_mm[1])))
+        throw PlanError(seg.line, "arc centre is not a finite number");
+}
+
+}  // namespace
+
+void validate(const PlannerConfig& cfg) {
+    for (int k = 0; k < kAxes; ++k) {
+        if (!(cfg.limits.vel_mm_s[k] > 0) || !(cfg.limits.acc_mm_s2[k] > 0))
+            throw std::invalid_argument("axis " + std::to_string(k) +
+                                        ": velocity and acceleration limits must be > 0");
+        if (!(cfg.limits.jerk_mm_s3[k] >= 0))
+            throw std::invalid_argument("axis " + std::to_string(k) +
+                                        ": jerk limit must be >= 0 (0 = unlimited)");
+    }
+    if (!(cfg.servo_period_s > 0)) throw std::invalid_argument("servo period must be > 0");
+    if (!(cfg.override_reserve > 0 && cfg.junction_share >= 0 &&
+          cfg.override_reserve + cfg.junction_share < 1))
+        throw std::invalid_argument(
+            "override_reserve must be > 0 and override_reserve + junction_share < 1");
+    if (!(cfg.max_rate >= 1)) throw std::invalid_argument("max_rate must be >= 1");
+    if (cfg.window < 2) throw std::invalid_argument("window must hold at least 2 elements");
+}
+
+Planner::Planner(const PlannerConfig& cfg, const AxisArray& start) : cfg_(cfg), last_end_(start) {
+    validate(cfg_);
+    jerk_mode_ = std::any_of(cfg_.limits.jerk_mm_s3.begin(), cfg_.limits.jerk_mm_s3.end(),
+                             [](double j) { return j > 0; });
+    items_.reserve(cfg_.window * 2);
+    vj_.reserve(cfg_.window * 2 + 1);
+}
+
+void Planner::reset(const AxisArray& start) {
+    last_end_ = start;
+    have_pending_ = false;
+    items_.clear();
+    head_ = 0;
+    v_start_ = 0;
+    out_.clear();
+    out_head_ = 0;
+}
+
+void Planner::push(const PathSegment& seg) {
+    validate_segment(seg);
+    Piece next{};
+    next.geom =
+        seg.kind == SegmentKind::Arc ? make_arc(last_end_, seg) : make_line(last_end_, seg.end_mm);
+    if (next.geom.length_mm < kMinLength_mm) {
+        if (have_pending_) pending_.exact_stop |= seg.exact_stop;
+        return;
+    }
+    next.feed_mm_s = seg.rapid ? 0 : seg.feed_mm_s;
+    next.tolerance_mm = seg.tolerance_mm;
+    next.exact_stop = seg.exact_stop;
+    next.line = seg.line;
+    last_end_ = seg.end_mm;
+    if (have_pending_) close_piece(pending_, &next);
+    pending_ = next;
+    have_pending_ = true;
+    if (items_.size() - head_ >= cfg_.window) plan_and_emit(false);
+}
+
+void Planner::finish() {
+    if (have_pending_) close_piece(pending_, nullptr);
+    have_pending_ = false;
+    if (plan_and_emit(true) > 0) out_.back().program_end = true;
+    v_start_ = 0;
+}
+
+Planner::Junction Planner::classify(const Piece& p, const Piece& next) const {
+    if (p.exact_stop) return {0, false, 0};
+    EndDerivs pe = end_derivs(p.geom);
+    EndDerivs ns = start_derivs(next.geom);
+    AxisArray dt;
+    double dmax = 0, dnorm2 = 0;
+    for (int k = 0; k < kAxes; ++k) {
+        dt[k] = ns.tangent[k] - pe.tangent[k];
+        dmax = std::max(dmax, std::fabs(dt[k]));
+        dnorm2 += dt[k] * dt[k];
+    }
+    const AxisLimits& lim = cfg_.limits;
+    double share = cfg_.junction_share, period = cfg_.servo_period_s;
+    // A step in curvature is a step in acceleration (v^2 times it); it matters only when jerk
+    // is limited, and then it may be junction_share of one period's jerk.
+    double curvature_cap = kInf;
+    for (int k = 0; k < kAxes && jerk_mode_; ++k) {
+        double step = std::fabs(ns.d2[k] - pe.d2[k]);
+        if (step > 1e-12 && lim.jerk_mm_s3[k] > 0)
+            curvature_cap =
+                std::min(curvature_cap, std::sqrt(share * lim.jerk_mm_s3[k] * period / step));
+    }
+    if (dmax <= kTangentEps) return {curvature_cap, std::isfinite(curvature_cap), 0};
+    bool lines = p.geom.kind == ElementKind::Line && next.geom.kind == ElementKind::Line;
+    if (lines && p.tolerance_mm > 0) {
+        double l = std::min(p.geom.length_mm, next.geom.length_mm) / 2;
+        l = std::min(l, p.tolerance_mm / (kBlendDeviationPerL * std::sqrt(dnorm2)));
+        if (l > kMinLength_mm) return {kInf, false, l};
+    }
+    // A kink that is not blended: pass it only as fast as a velocity step of junction_share of
+    // one servo period's acceleration (and jerk) allows. For real corners that speed is next
+    // to nothing, and stopping outright spares both neighbours the junction share.
+    double cap = kInf;
+    for (int k = 0; k < kAxes; ++k) {
+        if (std::fabs(dt[k]) <= kTangentEps) continue;
+        double step = share * lim.acc_mm_s2[k] * period;
+        if (lim.jerk_mm_s3[k] > 0)
+            step = std::min(step, share * lim.jerk_mm_s3[k] * period * period);
+        cap = std::min(cap, step / std::fabs(dt[k]));
+    }
+    double feed =
+        std::min(p.feed_mm_s > 0 ? p.feed_mm_s : kInf, next.feed_mm_s > 0 ? next.feed_mm_s : kInf);
+    if (!std::isfinite(feed)) feed = *std::max_element(lim.vel_mm_s.begin(), lim.vel_mm_s.end());
+    if (cap < kKinkStopFraction * feed) return {0, false, 0};
+    return {std::min(cap, curvature_cap), true, 0};
+}
+
+void Planner::close_piece(Piece& p, Piece* next) {
+    Junction jn = next ? classify(p, *next) : Junction{0, false, 0};
+    bool rough = p.rough_start || jn.rough;
+    if (p.geom.kind == ElementKind::Line) {
+        Element e = trim_line(p.geom, p.trim_start_mm, jn.blend_l_mm);
+        // Only a line blended at both ends can vanish, and its junctions are smooth.
+        if (e.length_mm > kMinLength_mm) add_item(e, p.feed_mm_s, jn.cap_mm_s, rough, p.line);
+    } else {
+        add_item(p.geom, p.feed_mm_s, jn.cap_mm_s, rough, p.line);
+    }
+    if (!next) return;
+    if (jn.blend_l_mm > 0) {
+        double f1 = p.feed_mm_s, f2 = next->feed_mm_s;
+        double feed = f1 > 0 && f2 > 0 ? std::min(f1, f2) : std::max(f1, f2);
+        Element blend = make_blend(p.geom.end, p.geom.a, next->geom.a, jn.blend_l_mm);
+        add_item(blend, feed, kInf, false, next->line);
+    }
+    next->trim_start_mm = jn.blend_l_mm;
+    next->rough_start = jn.rough;
+}
+
+void Planner::add_item(const Element& e, double feed, double end_cap, bool rough,
+                       std::int32_t line) {
+    Item it;
+    it.geom = e;
+    double cut = cfg_.override_reserve + (rough ? cfg_.junction_share : 0);
+    it.share = {1 - cut, 1 - cut};
+    it.lim = element_limits(e, bounds(e), cfg_.limits, feed, it.share);
+    it.end_cap_mm_s = end_cap;
+    it.rough = rough;
+    it.line = line;
+    items_.push_back(it);
+}
+
+double Planner::junction_bound(std::size_t i) const {
+    const Item& a = items_[head_ + i - 1];
+    const Item& b = items_[head_ + i];
+    return std::min({a.lim.vcap_mm_s, b.lim.vcap_mm_s, a.end_cap_mm_s});
+}
+
+std::size_t Planner::plan_and_emit(bool all) {
+    std::size_t n = items_.size() - head_;
+    if (n == 0) return 0;
+    vj_.assign(n + 1, 0.0);
+    // Backward pass: the highest speed at each junction from which everything after it, up to
+    // a stop at the window's end, can still be followed.
+    vj_[n] = 0;
+    for (std::size_t i = n - 1; i >= 1; --i) {
+        const Item& it = items_[head_ + i];
+        vj_[i] = std::min(junction_bound(i),
+                          reachable_speed_mm_s(vj_[i + 1], it.geom.length_mm, it.lim.tangent));
+    }
+    // Forward pass: as fast as can be reached from where the last emitted record ended.
+    vj_[0] = v_start_;
+    for (std::size_t i = 0; i < n; ++i) {
+        const Item& it = items_[head_ + i];
+        vj_[i + 1] =
+            std::min(vj_[i + 1], reachable_speed_mm_s(vj_[i], it.geom.length_mm, it.lim.tangent));
+    }
+    std::size_t count = all ? n : n - std::min(n, cfg_.window / 2);
+    for (std::size_t i = 0; i < count; ++i) emit(items_[head_ + i], vj_[i], vj_[i + 1]);
+    head_ += count;
+    v_start_ = vj_[count];
+    if (head_ == items_.size()) {
+        items_.clear();
+        head_ = 0;
+    } else if (head_ >= cfg_.window) {
+        items_.erase(items_.begin(), items_.begin() + static_cast<std::ptrdiff_t>(head_));
+        head_ = 0;
+    }
+    return count;
+}
+
+void Planner::emit(const Item& it, double v_in, double v_out) {
+    PreparedSegment rec;
+    rec.geom = it.geom;
+    rec.profile = build_profile(it.geom.length_mm, v_in, v_out, it.lim.vcap_mm_s, it.lim.tangent);
+    LimitShares rate_share{1 - cfg_.override_reserve, 1 - cfg_.override_reserve};
+    ElementBounds b = bounds(it.geom);
+    const Profile1D& prof = rec.profile;
+    for (int i = 0; i < prof.count; ++i) {
+        // Peaks of a cubic phase are at its ends (|v| and |a| are monotone within a phase).
+        const ProfilePhase& ph = prof.phases[i];
+        double dt = (i + 1 < prof.count ? prof.phases[i + 1].t0_s : prof.duration_s) - ph.t0_s;
+        double v = std::max(ph.v0_mm_s, ph.v0_mm_s + ph.a0_mm_s2 * dt + ph.j_mm_s3 * dt * dt / 2);
+        double a = std::max(std::fabs(ph.a0_mm_s2), std::fabs(ph.a0_mm_s2 + ph.j_mm_s3 * dt));
+        // Next to a junction that is not smooth the step there scales with the rate: stay at 1.
+        rec.phase_rate_cap[i] = it.rough ? 1.0
+                                         : rate_cap(b, cfg_.limits, v, a, std::fabs(ph.j_mm_s3),
+                                                    rate_share, cfg_.max_rate);
+    }
+    rec.line = it.line;
+    rec.seq = seq_++;
+    if (out_head_ == out_.size()) {
+        out_.clear();
+        out_head_ = 0;
+    }
+    out_.push_back(rec);
+}
+
+bool Planner::pop(PreparedSegment& out) noexcept {
+    if (out_head_ == out_.size()) return false;
+    out = out_[out_head_++];
+    return true;
+}
+
+std::size_t Planner::take(std::span<PreparedSegment> out) noexcept {
+    std::size_t n = std::min(out.size(), ready());
+    std::copy_n(out_.begin() + static_cast<std::ptrdiff_t>(out_head_), n, out.begin());
+    out_head_ += n;
+    return n;
+}
+
+}  // namespace motion

@@ -1,0 +1,157 @@
+#include "motion/profile.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace motion {
+namespace {
+
+bool jerk_limited(const TangentLimits& lim) {
+    return lim.jerk_mm_s3 > 0;
+}
+
+// Appends phases that change speed from v0 to v1 with zero acceleration at both ends.
+class PhaseWriter {
+  public:
+    explicit PhaseWriter(Profile1D& p) : p_(p) {}
+
+    void ramp(double v0, double v1, const TangentLimits& lim) {
+        double dv = v1 - v0;
+        if (dv == 0) return;
+        double sign = dv > 0 ? 1.0 : -1.0;
+        dv = std::fabs(dv);
+        double a = lim.acc_mm_s2;
+        if (!jerk_limited(lim)) {
+            push(sign * a, 0, dv / a);
+            return;
+        }
+        double j = lim.jerk_mm_s3;
+        if (dv >= a * a / j) {
+            push(0, sign * j, a / j);
+            push(sign * a, 0, dv / a - a / j);
+            push(sign * a, -sign * j, a / j);
+        } else {
+            double tj = std::sqrt(dv / j);
+            push(0, sign * j, tj);
+            push(sign * j * tj, -sign * j, tj);
+        }
+        v_ = v1;  // removes the rounding drift of the integrated speed
+        a_ = 0;
+    }
+
+    void cruise(double duration) { push(0, 0, duration); }
+
+    void start(double v) { v_ = v; }
+
+    double time() const { return t_; }
+
+  private:
+    // a0 is the acceleration at the phase start; it is passed explicitly so that phases that
+    // begin at a nominal value (0 or +-A) do not inherit rounding from the previous phase.
+    void push(double a0, double j, double dt) {
+        if (dt <= 0) return;
+        ProfilePhase& ph = p_.phases[p_.count++];
+        ph = {t_, s_, v_, a0, j};
+        s_ += v_ * dt + a0 * dt * dt / 2 + j * dt * dt * dt / 6;
+        v_ += a0 * dt + j * dt * dt / 2;
+        a_ = a0 + j * dt;
+        t_ += dt;
+        p_.peak_a_mm_s2 = std::max({p_.peak_a_mm_s2, std::fabs(a0), std::fabs(a_)});
+        p_.peak_j_mm_s3 = std::max(p_.peak_j_mm_s3, std::fabs(j));
+    }
+
+    Profile1D& p_;
+    double t_ = 0, s_ = 0, v_ = 0, a_ = 0;
+};
+
+}  // namespace
+
+PathState Profile1D::at(double t_s) const noexcept {
+    if (count == 0) return {};
+    t_s = std::clamp(t_s, 0.0, duration_s);
+    int i = count - 1;
+    while (i > 0 && phases[i].t0_s > t_s) --i;
+    const ProfilePhase& ph = phases[i];
+    double dt = t_s - ph.t0_s;
+    PathState st;
+    st.s_mm =
+        ph.s0_mm + ph.v0_mm_s * dt + ph.a0_mm_s2 * dt * dt / 2 + ph.j_mm_s3 * dt * dt * dt / 6;
+    st.v_mm_s = std::max(0.0, ph.v0_mm_s + ph.a0_mm_s2 * dt + ph.j_mm_s3 * dt * dt / 2);
+    st.a_mm_s2 = ph.a0_mm_s2 + ph.j_mm_s3 * dt;
+    st.j_mm_s3 = ph.j_mm_s3;
+    return st;
+}
+
+double ramp_time_s(double dv, const TangentLimits& lim) noexcept {
+    double a = lim.acc_mm_s2;
+    if (!jerk_limited(lim)) return dv / a;
+    double j = lim.jerk_mm_s3;
+    if (dv >= a * a / j) return dv / a + a / j;
+    return 2 * std::sqrt(dv / j);
+}
+
+double ramp_distance_mm(double v0, double v1, const TangentLimits& lim) noexcept {
+    // Both ramp shapes are point-symmetric in time, so the mean speed is (v0 + v1) / 2.
+    return (v0 + v1) / 2 * ramp_time_s(std::fabs(v1 - v0), lim);
+}
+
+double reachable_speed_mm_s(double v0, double length, const TangentLimits& lim) noexcept {
+    double a = lim.acc_mm_s2;
+    if (length <= 0) return v0;
+    if (!jerk_limited(lim)) return std::sqrt(v0 * v0 + 2 * a * length);
+    double j = lim.jerk_mm_s3;
+    double c = a * a / j;  // speed change below which the ramp never reaches full acceleration
+    // Jerk-limited branch: length = (2 v0 + x^2) x / sqrt(j) with x = sqrt(dv), a cubic
+    // x^3 + p x - q = 0 with p >= 0, which has exactly one real root.
+    double p = 2 * v0;
+    double q = length * std::sqrt(j);
+    double disc = std::sqrt(q * q / 4 + p * p * p / 27);
+    double x = std::cbrt(q / 2 + disc) + std::cbrt(q / 2 - disc);
+    for (int i = 0; i < 2; ++i) {  // Newton polish: Cardano loses digits when p dominates
+        double f = x * x * x + p * x - q;
+        x -= f / (3 * x * x + p);
+    }
+    double dv = x * x;
+    if (dv <= c) return v0 + dv;
+    // Acceleration-limited branch: 2 a length = (2 v0 + dv)(dv + c).
+    double b = 2 * v0 + c;
+    dv = (-b + std::sqrt(b * b - 4 * (2 * v0 * c - 2 * a * length))) / 2;
+    return v0 + std::max(dv, c);
+}
+
+Profile1D build_profile(double length, double v_in, double v_out, double vcap,
+                        const TangentLimits& lim) noexcept {
+    Profile1D prof;
+    double lo = std::max(v_in, v_out);
+    double vpeak = vcap;
+    auto needed = [&](double vp) {
+        return ramp_distance_mm(v_in, vp, lim) + ramp_distance_mm(vp, v_out, lim);
+    };
+    if (vpeak <= lo) {
+        vpeak = lo;
+    } else if (needed(vpeak) > length) {
+        if (!jerk_limited(lim)) {
+            double a = lim.acc_mm_s2;
+            vpeak = std::sqrt((2 * a * length + v_in * v_in + v_out * v_out) / 2);
+            vpeak = std::clamp(vpeak, lo, vcap);
+        } else {
+            double hi = vpeak;
+            vpeak = lo;
+            for (int i = 0; i < 60 && hi - vpeak > 1e-12 * hi; ++i) {
+                double mid = (vpeak + hi) / 2;
+                (needed(mid) <= length ? vpeak : hi) = mid;
+            }
+        }
+    }
+    PhaseWriter w(prof);
+    w.start(v_in);
+    w.ramp(v_in, vpeak, lim);
+    double cruise_mm = length - needed(vpeak);
+    if (vpeak > 0 && cruise_mm > 0) w.cruise(cruise_mm / vpeak);
+    w.ramp(vpeak, v_out, lim);
+    prof.duration_s = w.time();
+    prof.peak_v_mm_s = vpeak;
+    return prof;
+}
+
+}  // namespace motion

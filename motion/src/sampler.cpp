@@ -1,0 +1,224 @@
+#include "motion/sampler.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace motion {
+namespace {
+constexpr double kInf = std::numeric_limits<double>::infinity();
+}  // namespace
+
+MotionSample sample(const PreparedSegment& seg, double t) noexcept {
+    PathState ps = seg.profile.at(t);
+    if (t >= seg.profile.duration_s) ps.s_mm = seg.geom.length_mm;
+    CurvePoint cp;
+    evaluate(seg.geom, ps.s_mm, cp);
+    MotionSample out;
+    double v = ps.v_mm_s, a = ps.a_mm_s2, j = ps.j_mm_s3;
+    for (int k = 0; k < kAxes; ++k) {
+        out.pos_mm[k] = cp.p[k];
+        out.vel_mm_s[k] = v * cp.d1[k];
+        out.acc_mm_s2[k] = a * cp.d1[k] + v * v * cp.d2[k];
+        out.jerk_mm_s3[k] = j * cp.d1[k] + 3 * v * a * cp.d2[k] + v * v * v * cp.d3[k];
+    }
+    out.line = seg.line;
+    return out;
+}
+
+SamplerConfig sampler_config(const PlannerConfig& p) {
+    SamplerConfig s;
+    s.limits = p.limits;
+    s.override_reserve = p.override_reserve;
+    s.max_rate = p.max_rate;
+    return s;
+}
+
+RateLimits rate_limits(const SamplerConfig& cfg) noexcept {
+    // Half of the reserve each for the r' and r'' terms of the jerk; all of it for the r' term
+    // of the acceleration.
+    double eta = cfg.override_reserve;
+    double vm = kInf, am = kInf;
+    const AxisLimits& lim = cfg.limits;
+    for (int k = 0; k < kAxes; ++k) {
+        vm = std::min(vm, eta * lim.acc_mm_s2[k] / lim.vel_mm_s[k]);
+        if (lim.jerk_mm_s3[k] > 0) {
+            vm = std::min(vm, eta / 2 * lim.jerk_mm_s3[k] / (3 * cfg.max_rate * lim.acc_mm_s2[k]));
+            am = std::min(am, eta / 2 * lim.jerk_mm_s3[k] / lim.vel_mm_s[k]);
+        }
+    }
+    // Without a jerk limit r'' is free; a 5 ms ramp of r' keeps the rate smooth anyway.
+    if (!std::isfinite(am)) am = vm / 0.005;
+    return {vm, am};
+}
+
+Sampler::Sampler(const SamplerConfig& cfg, SpscRing<PreparedSegment>& ring, const AxisArray& start)
+    : cfg_(cfg), rl_(rate_limits(cfg)), ring_(ring) {
+    last_.pos_mm = start;
+    jerk_limited_ = std::any_of(cfg.limits.jerk_mm_s3.begin(), cfg.limits.jerk_mm_s3.end(),
+                                [](double j) { return j > 0; });
+}
+
+void Sampler::set_feed_override(double scale) noexcept {
+    override_ = std::clamp(std::isfinite(scale) ? scale : 0.0, 0.0, cfg_.max_rate);
+}
+
+void Sampler::set_hold(bool on) noexcept {
+    hold_ = on;
+}
+
+void Sampler::abort() noexcept {
+    abort_ = true;
+}
+
+void Sampler::clear_abort() noexcept {
+    if (!status_.aborted) return;
+    abort_ = false;
+    status_.aborted = false;
+    tau_ = 0;
+}
+
+double Sampler::rate_target() const noexcept {
+    if (abort_ || hold_) return 0;
+    return std::min(override_, rate_cap_ahead());
+}
+
+double Sampler::rate_cap_ahead() const noexcept {
+    if (override_ <= 1 && r_ <= 1 && rd_ <= 0) return kInf;  // every plan holds at rate <= 1
+    // Planned time that can pass before the rate could be brought down to 1: phases starting
+    // within it must have their caps respected from now on.
+    double up = std::max(rd_, 0.0);
+    double over = std::max(0.0, r_ + up * up / (2 * rl_.max_rate_per_s2) - 1);
+    double t_down = up / rl_.max_rate_per_s2 + over / rl_.max_rate_per_s +
+                    rl_.max_rate_per_s / rl_.max_rate_per_s2;
+    double horizon = tau_ + cfg_.max_rate * t_down;  // in the front record's time
+    std::size_t n = std::min(ring_.size(), cfg_.lookahead_records);
+    double cap = kInf, start = 0;  // start: planned time at which the record begins
+    bool end_seen = false;
+    for (std::size_t i = 0; i < n && start < horizon && !end_seen; ++i) {
+        const PreparedSegment& s = ring_.peek(i);
+        const Profile1D& p = s.profile;
+        for (int ph = 0; ph < p.count; ++ph) {
+            double ph_end = start + (ph + 1 < p.count ? p.phases[ph + 1].t0_s : p.duration_s);
+            if (ph_end >= tau_ && start + p.phases[ph].t0_s <= horizon)
+                cap = std::min(cap, s.phase_rate_cap[ph]);
+        }
+        start += p.duration_s;
+        end_seen = s.program_end;
+    }
+    if (start < horizon && !end_seen) cap = 1;  // unknown records ahead: plan rate is safe
+    return cap;
+}
+
+// Moves (r, r') towards (target, 0) for dt along the time-optimal path with |r'| and |r''|
+// bounded, integrating exactly over its constant-r'' pieces; returns the planned time passed.
+double Sampler::integrate_rate(double target, double dt) noexcept {
+    const double vm = rl_.max_rate_per_s, am = rl_.max_rate_per_s2;
+    double passed = 0, left = dt;
+    for (int iter = 0; iter < 4 && left > 0; ++iter) {
+        double d = target - r_;
+        if (std::fabs(d) <= 1e-12 && std::fabs(rd_) <= 1e-9) {
+            r_ = target;
+            rd_ = 0;
+            rdd_ = 0;
+            passed += r_ * left;
+            break;
+        }
+        double stop = rd_ * std::fabs(rd_) / (2 * am);
+        double s = d - stop > 0 ? 1.0 : (d - stop < 0 ? -1.0 : (rd_ > 0 ? -1.0 : 1.0));
+        double vp = s * std::min(vm, std::sqrt(std::max(0.0, s * d * am + rd_ * rd_ / 2)));
+        double ta = std::max(0.0, (vp - rd_) / (s * am));
+        double da = (vp * vp - rd_ * rd_) / (2 * s * am);
+        double dc = vp * vp / (2 * s * am);
+        double tb = vp != 0 ? std::max(0.0, (d - da - dc) / vp) : 0.0;
+        double tc = std::fabs(vp) / am;
+        const double pieces[3][2] = {{s * am, ta}, {0, tb}, {-s * am, tc}};
+        bool finished = true;
+        for (const auto& pc : pieces) {
+            double u = pc[0], h = std::min(left, pc[1]);
+            passed += r_ * h + rd_ * h * h / 2 + u * h * h * h / 6;
+            r_ += rd_ * h + u * h * h / 2;
+            rd_ += u * h;
+            rdd_ = u;
+            left -= h;
+            if (h < pc[1]) {
+                finished = false;
+                break;
+            }
+        }
+        if (finished) {  // landed on the target: remove the rounding drift
+            r_ = target;
+            rd_ = 0;
+            rdd_ = 0;
+        }
+    }
+    if (r_ < 0) r_ = 0;
+    return std::max(passed, 0.0);
+}
+
+void Sampler::consume_finished_records() noexcept {
+    while (ring_.size() > 0) {
+        const PreparedSegment& cur = ring_.peek(0);
+        if (tau_ < cur.profile.duration_s) return;
+        if (ring_.size() == 1) {
+            tau_ = cur.profile.duration_s;
+            return;
+        }
+        tau_ -= cur.profile.duration_s;
+        ring_.pop();
+    }
+}
+
+MotionSample Sampler::advance(double dt) noexcept {
+    if (status_.aborted) {  // discard until clear_abort()
+        while (ring_.size() > 0) ring_.pop();
+        last_.vel_mm_s = {};
+        last_.acc_mm_s2 = {};
+        last_.jerk_mm_s3 = {};
+        return last_;
+    }
+    if (ring_.size() == 0) {
+        r_ = abort_ || hold_ ? 0 : std::min(override_, 1.0);
+        rd_ = rdd_ = 0;
+        status_ = {false, false, false, hold_, abort_, r_};
+        if (abort_) status_.aborted = true;
+        last_.vel_mm_s = {};
+        last_.acc_mm_s2 = {};
+        last_.jerk_mm_s3 = {};
+        return last_;
+    }
+    double target = rate_target();
+    PathState now = ring_.peek(0).profile.at(tau_);
+    if (now.v_mm_s == 0 && (now.a_mm_s2 == 0 || !jerk_limited_)) {
+        // At rest the rate has nothing to scale yet: take the target at once.
+        r_ = target;
+        rd_ = rdd_ = 0;
+    }
+    tau_ += integrate_rate(target, dt);
+    consume_finished_records();
+    const PreparedSegment& cur = ring_.peek(0);
+    MotionSample planned = sample(cur, tau_);
+    for (int k = 0; k < kAxes; ++k) {
+        double v = planned.vel_mm_s[k], a = planned.acc_mm_s2[k], j = planned.jerk_mm_s3[k];
+        last_.pos_mm[k] = planned.pos_mm[k];
+        last_.vel_mm_s[k] = v * r_;
+        last_.acc_mm_s2[k] = a * r_ * r_ + v * rd_;
+        last_.jerk_mm_s3[k] = j * r_ * r_ * r_ + 3 * a * r_ * rd_ + v * rdd_;
+    }
+    last_.line = planned.line;
+    bool at_end = ring_.size() == 1 && tau_ >= cur.profile.duration_s;
+    status_.done = at_end && cur.program_end;
+    status_.starved = at_end && !cur.program_end;
+    if (at_end) {  // nothing left to follow: the rate no longer moves anything
+        last_.vel_mm_s = {};
+        last_.acc_mm_s2 = {};
+        last_.jerk_mm_s3 = {};
+    }
+    status_.moving = !at_end && r_ > 0;
+    status_.held = hold_ && r_ == 0 && rd_ == 0;
+    status_.aborted = abort_ && r_ == 0 && rd_ == 0;
+    status_.rate = r_;
+    return last_;
+}
+
+}  // namespace motion

@@ -1,0 +1,196 @@
+// Planner benchmark: motion time against the feed-rate bound, and planning throughput.
+// See docs/motion-planner.md ("Benchmark") for how to run it and what the figures mean.
+#include <fmt/format.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "motion/planner.hpp"
+#include "motion/sampler.hpp"
+#include "ngc_bench_fixture.hpp"
+
+namespace {
+
+using namespace motion;
+
+struct Settings {
+    double vel_mm_s = 100, acc_mm_s2 = 1000, period_s = 1e-3, tolerance_mm = 0.01;
+    double reserve = PlannerConfig{}.override_reserve;
+    double junction_share = PlannerConfig{}.junction_share;
+};
+
+PlannerConfig config_for(const Settings& s, double jerk) {
+    PlannerConfig cfg;
+    cfg.limits.vel_mm_s.fill(s.vel_mm_s);
+    cfg.limits.acc_mm_s2.fill(s.acc_mm_s2);
+    cfg.limits.jerk_mm_s3.fill(jerk);
+    cfg.servo_period_s = s.period_s;
+    cfg.override_reserve = s.reserve;
+    cfg.junction_share = s.junction_share;
+    return cfg;
+}
+
+std::vector<PreparedSegment> plan_all(const PlannerConfig& cfg, const bench::FixtureProgram& prog) {
+    Planner planner(cfg, prog.start_mm);
+    std::vector<PreparedSegment> out;
+    PreparedSegment rec;
+    for (const PathSegment& seg : prog.segments) {
+        planner.push(seg);
+        while (planner.pop(rec)) out.push_back(rec);
+    }
+    planner.finish();
+    while (planner.pop(rec)) out.push_back(rec);
+    return out;
+}
+
+double bound_s(const Settings& s, const bench::FixtureProgram& prog) {
+    double t = 0;
+    AxisArray pos = prog.start_mm;
+    for (const PathSegment& seg : prog.segments) {
+        double f = seg.rapid ? s.vel_mm_s : std::min(seg.feed_mm_s, s.vel_mm_s);
+        t += bench::programmed_length_mm(seg, pos) / f;
+        pos = seg.end_mm;
+    }
+    return t;
+}
+
+struct RunResult {
+    double planned_s = 0;
+    double sampled_s = 0;
+    AxisArray max_vel{}, max_acc{};
+    double end_error_mm = 0;
+};
+
+// Plays the plan through the realtime sampler at the servo period, as the servo thread would.
+RunResult run(const PlannerConfig& cfg, const bench::FixtureProgram& prog) {
+    RunResult res;
+    std::vector<PreparedSegment> recs = plan_all(cfg, prog);
+    for (const auto& r : recs) res.planned_s += r.profile.duration_s;
+    SpscRing<PreparedSegment> ring(recs.size() + 1);
+    for (const auto& r : recs) ring.try_push(r);
+    Sampler sampler(sampler_config(cfg), ring, prog.start_mm);
+    MotionSample ms;
+    long periods = 0;
+    do {
+        ms = sampler.advance(cfg.servo_period_s);
+        ++periods;
+        for (int k = 0; k < kAxes; ++k) {
+            res.max_vel[k] = std::max(res.max_vel[k], std::fabs(ms.vel_mm_s[k]));
+            res.max_acc[k] = std::max(res.max_acc[k], std::fabs(ms.acc_mm_s2[k]));
+        }
+    } while (!sampler.status().done && periods < 100'000'000);
+    res.sampled_s = periods * cfg.servo_period_s;
+    const AxisArray& end = prog.segments.back().end_mm;
+    for (int k = 0; k < kAxes; ++k)
+        res.end_error_mm = std::max(res.end_error_mm, std::fabs(ms.pos_mm[k] - end[k]));
+    return res;
+}
+
+// Lines where the plan spends the most time beyond length / min(F, vmax).
+void print_excess(const Settings& s, const PlannerConfig& cfg, const bench::FixtureProgram& prog,
+                  int count) {
+    std::vector<PreparedSegment> recs = plan_all(cfg, prog);
+    std::map<int, double> spent, ideal;
+    for (const auto& r : recs) spent[r.line] += r.profile.duration_s;
+    AxisArray pos = prog.start_mm;
+    for (const PathSegment& seg : prog.segments) {
+        double f = seg.rapid ? s.vel_mm_s : std::min(seg.feed_mm_s, s.vel_mm_s);
+        ideal[seg.line] += bench::programmed_length_mm(seg, pos) / f;
+        pos = seg.end_mm;
+    }
+    std::vector<std::pair<double, int>> excess;
+    for (const auto& [line, t] : spent) excess.emplace_back(t - ideal[line], line);
+    std::sort(excess.rbegin(), excess.rend());
+    for (int i = 0; i < count && i < int(excess.size()); ++i)
+        fmt::print("  line {:4}: {:+.4f} s over its bound\n", excess[i].second, excess[i].first);
+}
+
+double throughput_seg_s(const PlannerConfig& cfg, const bench::FixtureProgram& prog, double min_s) {
+    using clock = std::chrono::steady_clock;
+    auto t0 = clock::now();
+    long segs = 0;
+    double elapsed = 0;
+    PreparedSegment rec;
+    do {
+        Planner planner(cfg, prog.start_mm);
+        for (const PathSegment& seg : prog.segments) {
+            planner.push(seg);
+            while (planner.pop(rec)) {
+            }
+        }
+        planner.finish();
+        while (planner.pop(rec)) {
+        }
+        segs += long(prog.segments.size());
+        elapsed = std::chrono::duration<double>(clock::now() - t0).count();
+    } while (elapsed < min_s);
+    return segs / elapsed;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"Motion planner benchmark (tp_default settings by default)"};
+    std::string program = "/work/shared/bench/tp_default.ngc";
+    std::vector<double> jerks = {0, 100000, 20000};
+    Settings s;
+    bool smoke = false;
+    int excess = 0;
+    app.add_option("program", program, "G-code file (bench subset: G0-G3 G17 G21 G90 F)");
+    app.add_option("--jerk", jerks, "jerk limits to run, mm/s^3 (0 = unlimited)");
+    app.add_option("--vel", s.vel_mm_s, "per-axis velocity limit, mm/s");
+    app.add_option("--acc", s.acc_mm_s2, "per-axis acceleration limit, mm/s^2");
+    app.add_option("--reserve", s.reserve, "share of acc/jerk kept for override and hold");
+    app.add_option("--junction-share", s.junction_share,
+                   "share of acc/jerk for non-smooth junctions");
+    app.add_option("--tolerance", s.tolerance_mm, "blend tolerance (G64 P), mm");
+    app.add_option("--excess", excess, "list the N lines with the most time over their bound");
+    app.add_flag("--smoke", smoke, "one quick pass, for ctest");
+    CLI11_PARSE(app, argc, argv);
+
+    try {
+        bench::FixtureProgram prog = bench::read_ngc_fixture(program, s.tolerance_mm);
+        if (prog.segments.empty()) throw std::runtime_error(program + ": no moves");
+        double bound = bound_s(s, prog);
+        fmt::print("program {}: {} moves\n", program, prog.segments.size());
+        fmt::print(
+            "settings: {} mm/s, {} mm/s^2 per axis, servo {} Hz, G64 P{}, reserve {}, "
+            "junction share {}\n",
+            s.vel_mm_s, s.acc_mm_s2, 1 / s.period_s, s.tolerance_mm, s.reserve, s.junction_share);
+        fmt::print("bound sum(length / min(F, vmax)): {:.3f} s\n", bound);
+        double base = 0;
+        for (double j : jerks) {
+            PlannerConfig cfg = config_for(s, j);
+            RunResult r = run(cfg, prog);
+            if (j == 0) base = r.sampled_s;
+            std::string label = j > 0 ? fmt::format("jerk {:g} mm/s^3", j) : "jerk unlimited";
+            fmt::print("{}: motion time {:.3f} s (planned {:.4f} s), ratio {:.4f}", label,
+                       r.sampled_s, r.planned_s, r.sampled_s / bound);
+            if (j > 0 && base > 0) fmt::print(", extra {:+.3f} s vs unlimited", r.sampled_s - base);
+            fmt::print(
+                "\n  max |v| xyz {:.2f} {:.2f} {:.2f} mm/s, max |a| xyz {:.1f} {:.1f} {:.1f} "
+                "mm/s^2, end error {:.2e} mm\n",
+                r.max_vel[0], r.max_vel[1], r.max_vel[2], r.max_acc[0], r.max_acc[1], r.max_acc[2],
+                r.end_error_mm);
+            if (excess > 0) print_excess(s, cfg, prog, excess);
+            if (smoke) break;
+        }
+        if (!smoke) {
+            for (double j : {0.0, jerks.back()}) {
+                double tp = throughput_seg_s(config_for(s, j), prog, 1.0);
+                fmt::print("planning throughput ({}): {:.3g} segments/s\n",
+                           j > 0 ? fmt::format("jerk {:g}", j) : std::string("jerk unlimited"), tp);
+            }
+        }
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "bench_motion: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}

@@ -1,0 +1,167 @@
+// Sampler: time scaling by override, hold, abort; the SPSC ring between threads.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <thread>
+
+#include "motion/planner.hpp"
+#include "motion/sampler.hpp"
+
+namespace motion {
+namespace {
+
+PlannerConfig uniform(double v, double a, double j) {
+    PlannerConfig cfg;
+    cfg.limits.vel_mm_s.fill(v);
+    cfg.limits.acc_mm_s2.fill(a);
+    cfg.limits.jerk_mm_s3.fill(j);
+    return cfg;
+}
+
+// One long X move at `feed`, planned and loaded into a ring.
+struct Rig {
+    PlannerConfig cfg;
+    SpscRing<PreparedSegment> ring{16};
+    Sampler sampler;
+    double planned_s = 0;
+
+    Rig(const PlannerConfig& c, double length, double feed)
+        : cfg(c), sampler(sampler_config(c), ring, AxisArray{}) {
+        Planner p(cfg, {});
+        PathSegment s;
+        s.end_mm = {length};
+        s.feed_mm_s = feed;
+        p.push(s);
+        p.finish();
+        PreparedSegment r;
+        while (p.pop(r)) {
+            planned_s += r.profile.duration_s;
+            ring.try_push(r);
+        }
+    }
+
+    // Runs until done (or max periods); returns periods taken.
+    long run(long max_periods = 1'000'000) {
+        long n = 0;
+        while (!sampler.status().done && n < max_periods) {
+            sampler.advance(1e-3);
+            ++n;
+        }
+        return n;
+    }
+};
+
+TEST(Sampler, FullOverrideReproducesThePlannedTime) {
+    Rig rig(uniform(100, 1000, 0), 100, 50);
+    long n = rig.run();
+    EXPECT_NEAR(n * 1e-3, rig.planned_s, 1e-3 + 1e-9);
+}
+
+TEST(Sampler, HalfOverrideHalvesTheCruiseSpeed) {
+    Rig rig(uniform(100, 1000, 0), 100, 50);
+    rig.sampler.set_feed_override(0.5);
+    double vmax = 0;
+    for (int i = 0; i < 3000; ++i) vmax = std::max(vmax, rig.sampler.advance(1e-3).vel_mm_s[0]);
+    EXPECT_NEAR(vmax, 25, 1e-9);
+    long n = rig.run();
+    EXPECT_GT((3000 + n) * 1e-3, 2 * 100 / 50.0);  // cruise took twice as long
+}
+
+TEST(Sampler, OverrideAboveOneSpeedsUpCruiseButNotPastTheAxisLimit) {
+    Rig rig(uniform(100, 1000, 0), 200, 50);
+    rig.sampler.set_feed_override(1.2);
+    double vmax = 0;
+    for (int i = 0; i < 3000; ++i) vmax = std::max(vmax, rig.sampler.advance(1e-3).vel_mm_s[0]);
+    EXPECT_NEAR(vmax, 60, 1e-9);
+
+    Rig fast(uniform(100, 1000, 0), 200, 95);  // 1.2 * 95 would exceed 100 mm/s
+    fast.sampler.set_feed_override(1.2);
+    double vfast = 0;
+    for (int i = 0; i < 3000; ++i) vfast = std::max(vfast, fast.sampler.advance(1e-3).vel_mm_s[0]);
+    EXPECT_LE(vfast, 100 * (1 + 1e-12));
+    EXPECT_GT(vfast, 99);
+}
+
+TEST(Sampler, HoldStopsSmoothlyThenResumesToTheExactEnd) {
+    for (double jerk : {0.0, 1e5}) {
+        Rig rig(uniform(100, 1000, jerk), 100, 80);
+        for (int i = 0; i < 500; ++i) rig.sampler.advance(1e-3);
+        rig.sampler.set_hold(true);
+        RateLimits rl = rate_limits(sampler_config(rig.cfg));
+        AxisArray prev_acc{};
+        int n = 0;
+        while (!rig.sampler.status().held && n < 100000) {
+            MotionSample s = rig.sampler.advance(1e-3);
+            EXPECT_LE(std::fabs(s.acc_mm_s2[0]), 1000 * (1 + 1e-6));
+            if (jerk > 0) {
+                EXPECT_LE(std::fabs(s.acc_mm_s2[0] - prev_acc[0]) / 1e-3, jerk * (1 + 1e-6));
+            }
+            prev_acc = s.acc_mm_s2;
+            ++n;
+        }
+        // Time-optimal rate ramp from 1 to 0: 1/r'max plus one r'' ramp.
+        EXPECT_LE(n * 1e-3, 1 / rl.max_rate_per_s + rl.max_rate_per_s / rl.max_rate_per_s2 + 2e-3);
+        MotionSample still = rig.sampler.advance(1e-3);
+        for (int i = 0; i < 100; ++i) EXPECT_EQ(rig.sampler.advance(1e-3).pos_mm, still.pos_mm);
+        EXPECT_LT(still.pos_mm[0], 100);
+        rig.sampler.set_hold(false);
+        rig.run();
+        EXPECT_EQ(rig.sampler.advance(1e-3).pos_mm[0], 100);
+    }
+}
+
+TEST(Sampler, AbortStopsAndDiscardsTheRestUntilCleared) {
+    Rig rig(uniform(100, 1000, 1e5), 100, 80);
+    for (int i = 0; i < 500; ++i) rig.sampler.advance(1e-3);
+    rig.sampler.abort();
+    int n = 0;
+    while (!rig.sampler.status().aborted && n < 100000) {
+        rig.sampler.advance(1e-3);
+        ++n;
+    }
+    ASSERT_TRUE(rig.sampler.status().aborted);
+    MotionSample a = rig.sampler.advance(1e-3);
+    EXPECT_EQ(rig.ring.size(), 0u);
+    EXPECT_LT(a.pos_mm[0], 100);
+    for (int i = 0; i < 10; ++i) EXPECT_EQ(rig.sampler.advance(1e-3).pos_mm, a.pos_mm);
+    rig.sampler.clear_abort();
+    EXPECT_FALSE(rig.sampler.status().aborted);
+}
+
+TEST(Sampler, EmptyRingHoldsTheStartPosition) {
+    SpscRing<PreparedSegment> ring(4);
+    PlannerConfig cfg = uniform(100, 1000, 0);
+    Sampler s(sampler_config(cfg), ring, AxisArray{1, 2, 3});
+    MotionSample m = s.advance(1e-3);
+    EXPECT_EQ(m.pos_mm, (AxisArray{1, 2, 3}));
+    EXPECT_FALSE(s.status().moving);
+}
+
+TEST(SpscRing, TransfersEveryRecordInOrderBetweenThreads) {
+    struct Rec {
+        std::uint64_t seq;
+        double payload[6];
+    };
+    SpscRing<Rec> ring(64);
+    constexpr std::uint64_t kCount = 200000;
+    std::thread producer([&] {
+        for (std::uint64_t i = 0; i < kCount;) {
+            Rec r{i, {double(i)}};
+            if (ring.try_push(r)) ++i;
+        }
+    });
+    std::uint64_t expect = 0;
+    while (expect < kCount) {
+        if (ring.size() == 0) continue;
+        const Rec& r = ring.peek(0);
+        ASSERT_EQ(r.seq, expect);
+        ASSERT_EQ(r.payload[0], double(expect));
+        ring.pop();
+        ++expect;
+    }
+    producer.join();
+    EXPECT_EQ(ring.size(), 0u);
+}
+
+}  // namespace
+}  // namespace motion
