@@ -38,6 +38,32 @@ Vec2 sample(const OutMove& m, double t) {
     return m.centre + r0.norm() * Vec2(std::cos(a), std::sin(a));
 }
 
+/// Axis-aligned bounds; arcs use their whole circle (cheap and conservative).
+struct Box {
+    Vec2 lo;
+    Vec2 hi;
+};
+
+Box bounds(const Vec2& a, const Vec2& b) {
+    return {a.cwiseMin(b), a.cwiseMax(b)};
+}
+
+Box bounds(const OutMove& m) {
+    if (m.shape == Shape::Line) return bounds(m.start, m.end);
+    const double r = (m.start - m.centre).norm();
+    return {m.centre - Vec2(r, r), m.centre + Vec2(r, r)};
+}
+
+Box bounds(const Segment& s) {
+    if (s.shape == Shape::Line) return bounds(s.start, s.end);
+    return {s.centre - Vec2(s.radius, s.radius), s.centre + Vec2(s.radius, s.radius)};
+}
+
+double box_distance(const Box& a, const Box& b) {
+    const Vec2 gap = (a.lo - b.hi).cwiseMax(b.lo - a.hi).cwiseMax(Vec2::Zero());
+    return gap.norm();
+}
+
 bool full_circle(const Curve& c) {
     return c.shape == Shape::Arc && c.sweep >= 2.0 * std::numbers::pi - 1e-12;
 }
@@ -49,6 +75,7 @@ struct Compensator::Pending {
     struct Recent {
         Segment seg;
         SourceTag tag;
+        Box box;
     };
     Kind kind = Kind::StartUp;
     Segment seg;                     // the programmed move (StartUp: the start-up line)
@@ -68,7 +95,7 @@ struct Compensator::Pending {
         move = m;
         on_tag = on;
         upcoming.reset();
-        recent.push_back(Recent{s, m.tag});
+        recent.push_back(Recent{s, m.tag, bounds(s)});
         while (recent.size() > window) recent.pop_front();
     }
 };
@@ -272,7 +299,7 @@ void Compensator::join(const Move& move) {
     Pending& a = *pending_;
     const Segment seg = Segment::make(programmed_, programmed_h_, move);
     const Curve next = offset_or_throw(seg, move, a.on_tag);
-    a.upcoming = Pending::Recent{seg, move.tag};
+    a.upcoming = Pending::Recent{seg, move.tag, bounds(seg)};
     const Vec2 t_in = a.seg.tangent(1.0);
     const Vec2 t_out = seg.tangent(0.0);
     const double turn_sin = geom::cross(t_in, t_out);
@@ -402,17 +429,25 @@ void Compensator::emit_line(const Vec2& to, double to_h, bool rapid, Role role, 
 }
 
 void Compensator::check_gouge(const OutMove& piece, double radius_mm) const {
-    constexpr int kSamples = 64;
     constexpr double kToleranceMm = 1e-6;
+    // Samples about every r/10 along the piece, 4…256: dense CAM output of short
+    // moves stays cheap, and a bump narrower than that is far below the radius.
+    const double length = piece.shape == Shape::Arc
+                              ? (piece.start - piece.centre).norm() * piece.sweep_rad
+                              : (piece.end - piece.start).norm();
+    const int samples = static_cast<int>(
+        std::clamp(std::ceil(length / (0.1 * std::max(radius_mm, 1e-3))), 4.0, 256.0));
+    const Box box = bounds(piece);
     const double h_lo = std::min(piece.start_h, piece.end_h) - 1e-9;
     const double h_hi = std::max(piece.start_h, piece.end_h) + 1e-9;
     auto check = [&](const Pending::Recent& r) {
         // Moves at other heights (a contour repeated deeper) are not in this layer.
         if (std::max(r.seg.h0, r.seg.h1) < h_lo || std::min(r.seg.h0, r.seg.h1) > h_hi) return;
+        if (box_distance(box, r.box) >= radius_mm) return;
         double nearest = radius_mm;
-        for (int i = 0; i <= kSamples; ++i)
+        for (int i = 0; i <= samples; ++i)
             nearest =
-                std::min(nearest, r.seg.distance(sample(piece, static_cast<double>(i) / kSamples)));
+                std::min(nearest, r.seg.distance(sample(piece, static_cast<double>(i) / samples)));
         if (nearest < radius_mm - kToleranceMm)
             throw CompError(fmt::format("cutter comp: gouge: the tool path of line {} comes within "
                                         "{:.4g} of the contour of line {} (tool radius {:g})",
