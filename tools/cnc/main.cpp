@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "interp/canon_print.hpp"
 #include "interp/executor.hpp"
@@ -28,6 +29,7 @@ struct CommonOptions {
     bool optional_stop = false;
     bool no_g00_split = false;
     double default_feed_mm_min = 0;
+    std::vector<std::string> g904_trips;
 };
 
 void add_common(CLI::App& cmd, CommonOptions& o) {
@@ -44,6 +46,8 @@ void add_common(CLI::App& cmd, CommonOptions& o) {
     cmd.add_option("--default-feed", o.default_feed_mm_min,
                    "machine default feed (mm/min) for feed moves before any F; 0 = error")
         ->check(CLI::NonNegativeNumber);
+    cmd.add_option("--g904-trip", o.g904_trips,
+                   "AXIS=MM: machine coordinate where a G904 input changes (simulation)");
     cmd.add_flag("--no-g00-split", o.no_g00_split,
                  "G00 as one straight move (NcStudio splits Z first/last)");
 }
@@ -68,6 +72,13 @@ Session make_session(const CommonOptions& o) {
     s.cfg.g00_z_split = !o.no_g00_split;
     s.cfg.default_feed_mm_s = o.default_feed_mm_min / 60.0;
     s.iopts.dialect = interp::find_dialect(o.dialect);
+    for (const std::string& t : o.g904_trips) {
+        const auto eq = t.find('=');
+        const std::string axis = t.substr(0, eq);
+        if (eq == std::string::npos || axis.size() != 1 || axis[0] < 'X' || axis[0] > 'Z')
+            throw std::runtime_error("--g904-trip " + t + ": expected X=mm, Y=mm or Z=mm");
+        s.cfg.g904_trip_mm[axis[0] - 'X'] = std::stod(t.substr(eq + 1));
+    }
     return s;
 }
 

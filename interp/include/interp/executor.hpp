@@ -8,6 +8,7 @@
 // nothing and emits nothing (STYLE: parse, validate, then commit).
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,9 @@ struct BackendConfig {
     AxisVec reference_mm{};           // G28 reference point, machine coordinates
     AxisVec home_position_mm{};       // M902: machine origin position parameter per axis
     std::uint64_t input_bits = 0;     // standalone model of the input ports
+    // Standalone model of G904: the machine coordinate (X, Y, Z) at which the watched input
+    // changes. Without one, the input is taken to change at once and the axis does not move.
+    std::array<std::optional<double>, 3> g904_trip_mm{};
     // Machine settings readable as named parameters (SAFEHEIGHT, MOBICALI_THICKNESS, …), mm.
     std::map<std::string, double, std::less<>> machine_settings;
 };

@@ -214,6 +214,7 @@ private:
     void move_arc(bool ccw);
     void g28();
     void g904();
+    void simulate_g904(const canon::ConditionalMove& cm, const SourceLoc& loc);
     void g906();
     void g916();
     void write_g92();
@@ -822,6 +823,28 @@ void BlockRun::g904() {
     }
     if (!any) fail(loc, "G904 needs at least one axis (FX PX LX …)");
     emit(cm);
+    simulate_g904(cm, loc);
+}
+
+// Where the standalone model says a G904 axis stops (BackendConfig::g904_trip_mm). A trigger
+// behind the move or beyond the maximum travel is the alarm NCX-3 recommends.
+void BlockRun::simulate_g904(const canon::ConditionalMove& cm, const SourceLoc& loc) {
+    bool moved = false;
+    for (const auto& w : cm.axes) {
+        if (!w || !cfg_.g904_trip_mm[w->axis]) continue;
+        const double from = st.pos.machine_mm[w->axis];
+        const double to = *cfg_.g904_trip_mm[w->axis];
+        const char al = kAxisLetter[w->axis];
+        if ((to - from) * w->speed_mm_s < 0)
+            fail(loc, fmt::format("G904: {} moves away from where its input changes ({} mm)", al,
+                                  fmt_num(to)));
+        if (w->max_travel_mm && std::abs(to - from) > *w->max_travel_mm)
+            fail(loc, fmt::format("G904: {} travelled {} mm without the input changing", al,
+                                  fmt_num(*w->max_travel_mm)));
+        st.pos.machine_mm[w->axis] = to;
+        moved = true;
+    }
+    if (moved) resync_prog();
 }
 
 void BlockRun::g906() {

@@ -4,11 +4,14 @@
 //                with "format linuxcnc"), then "error: <message>" if the program must fail
 //   README.md    what was checked and how
 //   options      optional, one per line: dialect <name> | tool-table <file> | library <file> |
-//                default-feed <mm/min> | optional-stop | no-g00-split | format linuxcnc
+//                default-feed <mm/min> | optional-stop | no-g00-split | format linuxcnc |
+//                settings <file> | g904-trip <X|Y|Z> <machine mm>
 // The expected files were written and checked by hand or by geometry, never copied from output.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
+#include <optional>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -44,7 +47,8 @@ std::vector<std::string> case_names() {
 
 struct CaseOptions {
     std::string dialect = "ncstudio";
-    std::string tool_table, library;
+    std::string tool_table, library, settings;
+    std::array<std::optional<double>, 3> g904_trip_mm{};
     double default_feed_mm_min = 0;
     bool optional_stop = false, no_split = false, linuxcnc = false;
 };
@@ -57,6 +61,13 @@ CaseOptions read_options(const fs::path& dir) {
         if (key == "dialect") f >> o.dialect;
         else if (key == "tool-table") f >> o.tool_table;
         else if (key == "library") f >> o.library;
+        else if (key == "settings") f >> o.settings;
+        else if (key == "g904-trip") {
+            char axis = 0;
+            double mm = 0;
+            f >> axis >> mm;
+            o.g904_trip_mm[axis - 'X'] = mm;
+        }
         else if (key == "default-feed") f >> o.default_feed_mm_min;
         else if (key == "optional-stop") o.optional_stop = true;
         else if (key == "no-g00-split") o.no_split = true;
@@ -76,6 +87,7 @@ CaseOptions read_options(const fs::path& dir) {
 std::string run_case(const fs::path& dir) {
     const CaseOptions o = read_options(dir);
     interp::Settings settings;
+    if (!o.settings.empty()) settings = interp::load_settings((dir / o.settings).string());
     if (!o.tool_table.empty())
         settings.tools = interp::load_linuxcnc_tool_table((dir / o.tool_table).string());
     interp::BackendConfig cfg;
@@ -84,6 +96,7 @@ std::string run_case(const fs::path& dir) {
     cfg.optional_stop = o.optional_stop;
     cfg.g00_z_split = !o.no_split;
     cfg.default_feed_mm_s = o.default_feed_mm_min / 60.0;
+    cfg.g904_trip_mm = o.g904_trip_mm;
     interp::InterpreterOptions iopts;
     iopts.dialect = interp::find_dialect(o.dialect);
 

@@ -598,3 +598,35 @@ TEST_F(ExecTest, EndOfInputEndsTheProgram) {
 
 }  // namespace
 }  // namespace interp
+
+namespace interp {
+namespace {
+
+TEST(ExecG904Sim, TriggerStopsTheAxisAndBadTriggersAreAlarms) {
+    struct Null : CanonSink {
+        void emit(const Canon&) override {}
+    } sink;
+    BackendConfig cfg;
+    cfg.g904_trip_mm[2] = -5;
+    Executor exec(sink, cfg);
+    auto g904 = [&](double speed, std::optional<double> max_mm) {
+        Block b = test::blk(max_mm ? "G904 Z" + std::to_string(*max_mm) : "G904", 4);
+        b.kw.f_axis[2] = speed;
+        b.kw.p_axis[2] = 1;
+        b.kw.l_axis[2] = 1;
+        try {
+            exec.execute(b);
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string("ok");
+    };
+    EXPECT_EQ(g904(60, std::nullopt), "test.nc:4:1: G904: Z moves away from where its input changes (-5 mm)");
+    EXPECT_EQ(g904(-60, 2.0), "test.nc:4:1: G904: Z travelled 2 mm without the input changing");
+    EXPECT_EQ(g904(-60, 10.0), "ok");
+    EXPECT_DOUBLE_EQ(exec.machine_pos_mm(Axis::Z), -5);
+    EXPECT_DOUBLE_EQ(exec.work_pos_mm(Axis::Z), -5);
+}
+
+}  // namespace
+}  // namespace interp
