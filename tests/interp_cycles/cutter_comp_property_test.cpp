@@ -146,7 +146,11 @@ Contour random_contour(std::mt19937& rng) {
     return c;
 }
 
-void check_contour(const Contour& c, Side side, double r, std::uint32_t seed) {
+/// With helix set, move i ends 0.5 mm lower than move i−1 (a descending
+/// spiral): the heights must run continuously (no vertical step at a trimmed
+/// corner) and each offset piece must end within its move's height range.
+void check_contour(const Contour& c, Side side, double r, std::uint32_t seed, bool helix = false) {
+    auto end_h = [&](SourceTag tag) { return helix ? -0.5 * static_cast<double>(tag) : 0.0; };
     const std::size_t m = c.pieces.size();
     const Vec2 d0 = (c.pieces[0].b - c.pieces[0].a).normalized();
     const double s = side == Side::Left ? 1 : -1;
@@ -162,11 +166,13 @@ void check_contour(const Contour& c, Side side, double r, std::uint32_t seed) {
         mv.side = sd;
         mv.radius_mm = r;
         mv.tag = tag;
+        mv.end_h = end_h(tag);
         comp.push(mv);
     };
     push(make_line(start, c.pieces[0].a), side, 1);
     for (std::size_t i = 0; i < m; ++i) push(c.pieces[i], side, static_cast<SourceTag>(i + 2));
     push(make_line(c.pieces[0].a, start), Side::Off, static_cast<SourceTag>(m + 2));
+    double at_h = 0.0;
     comp.finish();
     std::vector<bool> covered(m, false);
     Vec2 at = start;
@@ -175,7 +181,15 @@ void check_contour(const Contour& c, Side side, double r, std::uint32_t seed) {
         ASSERT_NE(mv, nullptr) << "seed " << seed;
         ASSERT_LT((mv->start - at).norm(), 1e-7)
             << "seed " << seed << " gap before tag " << mv->tag;
+        ASSERT_NEAR(mv->start_h, at_h, 1e-9) << "seed " << seed << " tag " << mv->tag;
         at = mv->end;
+        at_h = mv->end_h;
+        if (mv->role == Role::Contour) {
+            const double lo = std::min(end_h(mv->tag - 1), end_h(mv->tag)) - 1e-9;
+            const double hi = std::max(end_h(mv->tag - 1), end_h(mv->tag)) + 1e-9;
+            EXPECT_TRUE(mv->end_h >= lo && mv->end_h <= hi)
+                << "seed " << seed << " tag " << mv->tag;
+        }
         if (mv->role == Role::Startup || mv->role == Role::Cancel) continue;
         for (int k = 0; k <= 40; ++k) {
             const Vec2 p = sample(*mv, k / 40.0);
@@ -191,6 +205,7 @@ void check_contour(const Contour& c, Side side, double r, std::uint32_t seed) {
         if (mv->role == Role::Contour) covered[mv->tag - 2] = true;
     }
     EXPECT_LT((at - start).norm(), 1e-9) << "seed " << seed;
+    EXPECT_NEAR(at_h, end_h(static_cast<SourceTag>(m + 2)), 1e-9) << "seed " << seed;
     for (std::size_t i = 0; i < m; ++i) EXPECT_TRUE(covered[i]) << "seed " << seed << " seg " << i;
 }
 
@@ -205,6 +220,7 @@ TEST(CutterCompProperty, RandomClosedContoursKeepExactlyTheRadius) {
             const double r = c.max_radius * u(rng);
             try {
                 ASSERT_NO_FATAL_FAILURE(check_contour(c, side, r, seed));
+                ASSERT_NO_FATAL_FAILURE(check_contour(c, side, r, seed, true));
             } catch (const CompError& e) {
                 FAIL() << "seed " << seed << " side " << (side == Side::Left ? "G41" : "G42")
                        << " r " << r << ": " << e.what();

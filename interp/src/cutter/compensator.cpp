@@ -464,6 +464,9 @@ void Compensator::emit_piece(OutMove piece, bool rapid, Role role, SourceTag tag
                               : (piece.end - piece.start).norm();
     if (length <= kSamePointMm && std::abs(piece.end_h - piece.start_h) <= kSamePointMm) return;
     if (piece.shape == Shape::Line) piece.start = tool_;
+    // A helix trimmed at an inside corner starts at the height the previous move
+    // reached there, not at its own interpolated height: no vertical step.
+    piece.start_h = tool_h_;
     piece.rapid = rapid;
     piece.role = role;
     piece.tag = tag;
