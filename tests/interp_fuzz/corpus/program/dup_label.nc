@@ -1,0 +1,6 @@
+G65 P"frame" L2
+M30
+O"frame"
+G1 X=#CURWORKPOS.X+1 Y=#SAFEHEIGHT
+M17
+O"frame"
