@@ -68,7 +68,7 @@ struct Counter : hal::Instance {
         reset_on_index_.store(index_enable, std::memory_order_release);
     }
 
-private:
+  private:
     // update-counters side
     bool old_a_ = false;
     bool old_z_ = false;

@@ -20,8 +20,8 @@ std::size_t group_size(const hal::Instance& self) {
         throw hal::Error("debounce needs cfg=size[,size...]: one filter count per group");
     const long size = self.arg_int("cfg", 0);
     if (size < 1 || size > kMaxFilters)
-        throw hal::Error("debounce: cfg item " + std::to_string(size) +
-                         " for group " + std::string(self.name()) + " must be from 1 to " +
+        throw hal::Error("debounce: cfg item " + std::to_string(size) + " for group " +
+                         std::string(self.name()) + " must be from 1 to " +
                          std::to_string(kMaxFilters));
     return static_cast<std::size_t>(size);
 }
@@ -55,7 +55,7 @@ struct Debounce : hal::Instance {
         }
     }
 
-private:
+  private:
     std::unique_ptr<std::int32_t[]> count_;
     std::unique_ptr<bool[]> state_;  // out pins cannot be read back
 };

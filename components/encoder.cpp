@@ -51,8 +51,12 @@ constexpr std::uint8_t kCounter[16] = {0x00, 0x48, 0x00, 0x00, 0x00, 0x00, 0x00,
 std::uint64_t pack(std::uint32_t high, std::int32_t low) noexcept {
     return (std::uint64_t{high} << 32) | static_cast<std::uint32_t>(low);
 }
-std::uint32_t high_of(std::uint64_t w) noexcept { return static_cast<std::uint32_t>(w >> 32); }
-std::int32_t low_of(std::uint64_t w) noexcept { return static_cast<std::int32_t>(w & 0xFFFFFFFFu); }
+std::uint32_t high_of(std::uint64_t w) noexcept {
+    return static_cast<std::uint32_t>(w >> 32);
+}
+std::int32_t low_of(std::uint64_t w) noexcept {
+    return static_cast<std::int32_t>(w & 0xFFFFFFFFu);
+}
 
 struct Encoder : hal::Instance {
     hal::In<bool> phase_a{this, "phase-A"};
@@ -161,7 +165,7 @@ struct Encoder : hal::Instance {
         velocity_rpm = velocity_ * 60.0;
     }
 
-private:
+  private:
     bool missing_teeth_gap(std::uint32_t now) noexcept {
         const std::int32_t teeth = missing_teeth;
         const std::uint32_t interval = now - last_edge_ns_;
@@ -234,11 +238,11 @@ private:
     std::uint32_t latch_seq_ = 0;
 
     // Handed from update-counters to capture-position.
-    std::atomic<std::uint32_t> timebase_{0};       // ns, wraps; differences stay right
-    std::atomic<std::uint64_t> count_event_{0};    // (time stamp, raw count) of the last count
-    std::atomic<std::uint64_t> index_event_{0};    // (sequence, raw count at the index)
-    std::atomic<std::uint64_t> latch_event_{0};    // (sequence, raw count at the latch edge)
-    std::atomic<bool> index_armed_{false};         // set by capture from index-enable
+    std::atomic<std::uint32_t> timebase_{0};     // ns, wraps; differences stay right
+    std::atomic<std::uint64_t> count_event_{0};  // (time stamp, raw count) of the last count
+    std::atomic<std::uint64_t> index_event_{0};  // (sequence, raw count at the index)
+    std::atomic<std::uint64_t> latch_event_{0};  // (sequence, raw count at the latch edge)
+    std::atomic<bool> index_armed_{false};       // set by capture from index-enable
 
     // Written by capture-position only.
     std::uint64_t seen_count_event_ = 0;

@@ -31,7 +31,7 @@ struct EstopLatch : hal::Instance {
         old_reset_ = reset_now;
     }
 
-private:
+  private:
     bool ok_ = false;
     bool watchdog_ = false;
     bool old_reset_ = false;

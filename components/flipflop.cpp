@@ -27,7 +27,7 @@ struct Flipflop : hal::Instance {
         old_clk_ = clock;
     }
 
-private:
+  private:
     bool old_clk_ = false;
 };
 

@@ -44,7 +44,7 @@ struct Oneshot : hal::Instance {
         drive();
     }
 
-private:
+  private:
     void drive() noexcept {
         time_left = static_cast<double>(left_ns_) * 1e-9;
         out = left_ns_ > 0;

@@ -51,7 +51,7 @@ namespace {
 // there is one; writes always go to the pin's own storage, which is what an unlinked pin reads.
 template <class T>
 class SelfWritableIn {
-public:
+  public:
     SelfWritableIn(hal::Instance* owner, std::string_view name, T initial = T{}) {
         own_ = static_cast<T*>(hal::detail::register_pin(*owner, name, hal::TypeOf<T>::value,
                                                          hal::Dir::In,
@@ -66,7 +66,7 @@ public:
     operator T() const noexcept { return get(); }
     void set_own(T v) noexcept { hal::detail::store(own_, v); }
 
-private:
+  private:
     mutable T* ptr_;  // retargeted by the runtime when the pin is linked or unlinked
     T* own_;
 };
@@ -140,7 +140,7 @@ struct Pid : hal::Instance {
         publish_debug();
     }
 
-private:
+  private:
     struct DebugPins {
         explicit DebugPins(hal::Instance* owner)
             : error_i{owner, "errorI"},

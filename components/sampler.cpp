@@ -24,8 +24,9 @@ namespace {
 std::string sampler_layout(const hal::Instance& self) {
     auto cfg = self.arg("cfg");
     if (!cfg || cfg->empty())
-        throw hal::Error("sampler needs cfg=LETTERS[,LETTERS...]: one letter per pin "
-                         "(b bit, f float, s s32, u u32, l s64, k u64)");
+        throw hal::Error(
+            "sampler needs cfg=LETTERS[,LETTERS...]: one letter per pin "
+            "(b bit, f float, s s32, u u32, l s64, k u64)");
     return *cfg;
 }
 
@@ -50,12 +51,18 @@ SampledPin make_pin(hal::Instance* owner, const std::string& name) {
 SampledPin make_sampled_pin(hal::Instance* owner, hal::Type type, std::size_t column) {
     const std::string name = "pin." + std::to_string(column);
     switch (type) {
-        case hal::Type::Bit: return make_pin<bool>(owner, name);
-        case hal::Type::Float: return make_pin<double>(owner, name);
-        case hal::Type::S32: return make_pin<std::int32_t>(owner, name);
-        case hal::Type::U32: return make_pin<std::uint32_t>(owner, name);
-        case hal::Type::S64: return make_pin<std::int64_t>(owner, name);
-        case hal::Type::U64: return make_pin<std::uint64_t>(owner, name);
+        case hal::Type::Bit:
+            return make_pin<bool>(owner, name);
+        case hal::Type::Float:
+            return make_pin<double>(owner, name);
+        case hal::Type::S32:
+            return make_pin<std::int32_t>(owner, name);
+        case hal::Type::U32:
+            return make_pin<std::uint32_t>(owner, name);
+        case hal::Type::S64:
+            return make_pin<std::int64_t>(owner, name);
+        case hal::Type::U64:
+            return make_pin<std::uint64_t>(owner, name);
     }
     throw hal::Error("sampler: unknown field type");
 }
@@ -91,7 +98,7 @@ struct Sampler : hal::Instance {
         full = used >= stream.depth();
     }
 
-private:
+  private:
     std::vector<SampledPin> pins_;
     std::vector<hal::Value> record_;  // sized once here; the realtime path never allocates
 };

@@ -58,7 +58,7 @@ struct Siggen : hal::Instance {
         cosine = std::cos(angle) * amp + off;
     }
 
-private:
+  private:
     double index_ = 0.0;
 };
 

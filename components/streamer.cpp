@@ -26,8 +26,9 @@ namespace {
 std::string streamer_layout(const hal::Instance& self) {
     auto cfg = self.arg("cfg");
     if (!cfg || cfg->empty())
-        throw hal::Error("streamer needs cfg=LETTERS[,LETTERS...]: one letter per pin "
-                         "(b bit, f float, s s32, u u32, l s64, k u64)");
+        throw hal::Error(
+            "streamer needs cfg=LETTERS[,LETTERS...]: one letter per pin "
+            "(b bit, f float, s s32, u u32, l s64, k u64)");
     return *cfg;
 }
 
@@ -52,24 +53,36 @@ StreamedPin make_pin(hal::Instance* owner, const std::string& name) {
 StreamedPin make_streamed_pin(hal::Instance* owner, hal::Type type, std::size_t column) {
     const std::string name = "pin." + std::to_string(column);
     switch (type) {
-        case hal::Type::Bit: return make_pin<bool>(owner, name);
-        case hal::Type::Float: return make_pin<double>(owner, name);
-        case hal::Type::S32: return make_pin<std::int32_t>(owner, name);
-        case hal::Type::U32: return make_pin<std::uint32_t>(owner, name);
-        case hal::Type::S64: return make_pin<std::int64_t>(owner, name);
-        case hal::Type::U64: return make_pin<std::uint64_t>(owner, name);
+        case hal::Type::Bit:
+            return make_pin<bool>(owner, name);
+        case hal::Type::Float:
+            return make_pin<double>(owner, name);
+        case hal::Type::S32:
+            return make_pin<std::int32_t>(owner, name);
+        case hal::Type::U32:
+            return make_pin<std::uint32_t>(owner, name);
+        case hal::Type::S64:
+            return make_pin<std::int64_t>(owner, name);
+        case hal::Type::U64:
+            return make_pin<std::uint64_t>(owner, name);
     }
     throw hal::Error("streamer: unknown field type");
 }
 
 template <class T>
 T value_as(const hal::Value& v) noexcept {
-    if constexpr (std::is_same_v<T, bool>) return v.b;
-    else if constexpr (std::is_same_v<T, double>) return v.f;
-    else if constexpr (std::is_same_v<T, std::int32_t>) return v.s32;
-    else if constexpr (std::is_same_v<T, std::uint32_t>) return v.u32;
-    else if constexpr (std::is_same_v<T, std::int64_t>) return v.s64;
-    else return v.u64;
+    if constexpr (std::is_same_v<T, bool>)
+        return v.b;
+    else if constexpr (std::is_same_v<T, double>)
+        return v.f;
+    else if constexpr (std::is_same_v<T, std::int32_t>)
+        return v.s32;
+    else if constexpr (std::is_same_v<T, std::uint32_t>)
+        return v.u32;
+    else if constexpr (std::is_same_v<T, std::int64_t>)
+        return v.s64;
+    else
+        return v.u64;
 }
 
 template <class T>
@@ -110,15 +123,19 @@ struct Streamer : hal::Instance {
         empty = used == 0;
     }
 
-private:
+  private:
     // Whether this call should take a record; keeps the last two clock samples.
     bool clocked() noexcept {
         clock_history_ = ((clock_history_ << 1) | (clock ? 1 : 0)) & 3;
         switch (clock_mode) {
-            case 1: return clock_history_ == 2;  // was high, now low
-            case 2: return clock_history_ == 1;  // was low, now high
-            case 3: return clock_history_ == 1 || clock_history_ == 2;
-            default: return true;
+            case 1:
+                return clock_history_ == 2;  // was high, now low
+            case 2:
+                return clock_history_ == 1;  // was low, now high
+            case 3:
+                return clock_history_ == 1 || clock_history_ == 2;
+            default:
+                return true;
         }
     }
 

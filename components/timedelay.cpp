@@ -37,7 +37,7 @@ struct Timedelay : hal::Instance {
         }
     }
 
-private:
+  private:
     std::int64_t timer_ns_ = 0;
     bool out_ = false;
 };

@@ -42,7 +42,7 @@ struct Timedelta : hal::Instance {
         }
     }
 
-private:
+  private:
     void measure(std::int64_t delta_ns, std::int64_t period_ns) noexcept {
         out = saturate_s32(delta_ns);
         const std::int64_t error_ns = delta_ns - period_ns;

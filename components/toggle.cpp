@@ -31,7 +31,7 @@ struct Toggle : hal::Instance {
         }
     }
 
-private:
+  private:
     std::int32_t counter_ = 0;
     bool pressed_ = false;  // debounced button state
 };
