@@ -83,7 +83,8 @@ ElementBounds bounds(const Element& e) noexcept {
             double k1 = std::fabs(e.sweep_rad / e.length_mm);
             double r = e.radius_mm;
             for (int k = 0; k < kAxes; ++k) {
-                double q = std::hypot(e.a[k], e.b[k]);  // amplitude of the rotating component
+                // amplitude of the rotating component
+                double q = std::sqrt(e.a[k] * e.a[k] + e.b[k] * e.b[k]);
                 b.tangential_in_plane[k] = r * k1 * q;
                 b.linear[k] = std::fabs(e.c[k]) / e.length_mm;
                 b.g1[k] = b.tangential_in_plane[k] + b.linear[k];

@@ -42,7 +42,7 @@ double arc_axis_acc(double t, double l, double n, double m) {
     double lo = 0, hi = m / std::max(t, l);  // sqrt(.) >= a t and >= 0, so a <= m / max(t, l)
     for (int i = 0; i < 50; ++i) {
         double mid = (lo + hi) / 2;
-        (std::hypot(mid * t, n) + mid * l <= m ? lo : hi) = mid;
+        (std::sqrt(mid * t * mid * t + n * n) + mid * l <= m ? lo : hi) = mid;
     }
     return lo;
 }
@@ -84,16 +84,23 @@ ElementLimits element_limits(const Element& e, const ElementBounds& b, const Axi
 
 double rate_cap(const ElementBounds& b, const AxisLimits& lim, double v, double a, double j,
                 const LimitShares& share, double max_rate) noexcept {
-    double r = max_rate;
+    // r scales velocity by r, acceleration by r^2 and jerk by r^3: collect the smallest
+    // allowed r, r^2 and r^3 first, then take one root of each.
+    double r1 = max_rate, r2 = kInf, r3 = kInf;
     for (int k = 0; k < kAxes; ++k) {
+        if (b.g1[k] == 0 && b.g2[k] == 0) continue;
         double vk = v * b.g1[k];
         double ak = a * b.g1[k] + v * v * b.g2[k];
-        double jk = j * b.g1[k] + 3 * v * a * b.g2[k] + v * v * v * b.g3[k];
-        if (vk > 0) r = std::min(r, lim.vel_mm_s[k] / vk);
-        if (ak > 0) r = std::min(r, std::sqrt(share.acc * lim.acc_mm_s2[k] / ak));
-        if (jk > 0 && lim.jerk_mm_s3[k] > 0)
-            r = std::min(r, std::cbrt(share.jerk * lim.jerk_mm_s3[k] / jk));
+        if (vk > 0) r1 = std::min(r1, lim.vel_mm_s[k] / vk);
+        if (ak > 0) r2 = std::min(r2, share.acc * lim.acc_mm_s2[k] / ak);
+        if (lim.jerk_mm_s3[k] > 0) {
+            double jk = j * b.g1[k] + 3 * v * a * b.g2[k] + v * v * v * b.g3[k];
+            if (jk > 0) r3 = std::min(r3, share.jerk * lim.jerk_mm_s3[k] / jk);
+        }
     }
+    double r = r1;
+    if (r2 < r * r) r = std::sqrt(r2);
+    if (r3 < r * r * r) r = std::cbrt(r3);
     return std::max(r, 1.0);
 }
 

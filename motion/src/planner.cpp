@@ -16,6 +16,10 @@ constexpr double kTangentEps = 1e-12;   // max per-axis tangent difference treat
 constexpr double kBlendDeviationPerL = 3.0 / 16.0;
 // A kink whose allowed speed is below this fraction of the feed is taken as an exact stop.
 constexpr double kKinkStopFraction = 0.02;
+// Jerk-limited elements share one S-curve profile when their limits are within this ratio.
+constexpr double kJoinRatio = 0.8;
+constexpr double kJoinSpeedRatio = 0.999;
+constexpr std::size_t kMaxGroupItems = 256;
 
 bool finite_array(const AxisArray& a) {
     return std::all_of(a.begin(), a.end(), [](double x) { return std::isfinite(x); });
@@ -58,6 +62,7 @@ Planner::Planner(const PlannerConfig& cfg, const AxisArray& start) : cfg_(cfg), 
                              [](double j) { return j > 0; });
     items_.reserve(cfg_.window * 2);
     vj_.reserve(cfg_.window * 2 + 1);
+    out_.reserve(cfg_.window * 2);
 }
 
 void Planner::reset(const AxisArray& start) {
@@ -178,34 +183,77 @@ void Planner::add_item(const Element& e, double feed, double end_cap, bool rough
     items_.push_back(it);
 }
 
-double Planner::junction_bound(std::size_t i) const {
-    const Item& a = items_[head_ + i - 1];
-    const Item& b = items_[head_ + i];
-    return std::min({a.lim.vcap_mm_s, b.lim.vcap_mm_s, a.end_cap_mm_s});
+bool Planner::can_join(const Group& g, const Item& it) const {
+    // Only smooth junctions, and only between elements with similar limits: the group runs
+    // under the smallest of them.
+    auto similar = [](double a, double b, double ratio) {
+        if (a == 0 || b == 0) return a == b;  // 0 = unlimited jerk
+        return std::min(a, b) >= ratio * std::max(a, b);
+    };
+    // Compared with the group's first element, so that the group cannot drift downwards.
+    const Item& ref = items_[g.first];
+    // The speed cap must match (a group runs under its smallest cap); acceleration and jerk
+    // may differ a little.
+    return std::isinf(g.end_cap_mm_s) &&
+           similar(ref.lim.vcap_mm_s, it.lim.vcap_mm_s, kJoinSpeedRatio) &&
+           similar(ref.lim.tangent.acc_mm_s2, it.lim.tangent.acc_mm_s2, kJoinRatio) &&
+           similar(ref.lim.tangent.jerk_mm_s3, it.lim.tangent.jerk_mm_s3, kJoinRatio);
+}
+
+void Planner::build_groups() {
+    groups_.clear();
+    // Without a jerk limit every element gets its own trapezoid, which is already time-optimal.
+    std::size_t max_items =
+        jerk_mode_ ? std::clamp<std::size_t>(cfg_.window / 4, 1, kMaxGroupItems) : 1;
+    for (std::size_t i = head_; i < items_.size(); ++i) {
+        const Item& it = items_[i];
+        if (!groups_.empty()) {
+            Group& g = groups_.back();
+            if (g.end - g.first < max_items && can_join(g, it)) {
+                g.end = i + 1;
+                g.length_mm += it.geom.length_mm;
+                g.vcap_mm_s = std::min(g.vcap_mm_s, it.lim.vcap_mm_s);
+                g.tangent.acc_mm_s2 = std::min(g.tangent.acc_mm_s2, it.lim.tangent.acc_mm_s2);
+                g.tangent.jerk_mm_s3 = std::min(g.tangent.jerk_mm_s3, it.lim.tangent.jerk_mm_s3);
+                g.end_cap_mm_s = it.end_cap_mm_s;
+                continue;
+            }
+        }
+        groups_.push_back(
+            {i, i + 1, it.geom.length_mm, it.lim.vcap_mm_s, it.end_cap_mm_s, it.lim.tangent});
+    }
 }
 
 std::size_t Planner::plan_and_emit(bool all) {
     std::size_t n = items_.size() - head_;
     if (n == 0) return 0;
-    vj_.assign(n + 1, 0.0);
+    build_groups();
+    std::size_t m = groups_.size();
+    vj_.assign(m + 1, 0.0);
     // Backward pass: the highest speed at each junction from which everything after it, up to
     // a stop at the window's end, can still be followed.
-    vj_[n] = 0;
-    for (std::size_t i = n - 1; i >= 1; --i) {
-        const Item& it = items_[head_ + i];
-        vj_[i] = std::min(junction_bound(i),
-                          reachable_speed_mm_s(vj_[i + 1], it.geom.length_mm, it.lim.tangent));
+    vj_[m] = 0;
+    for (std::size_t i = m - 1; i >= 1; --i) {
+        const Group& a = groups_[i - 1];
+        const Group& g = groups_[i];
+        double bound = std::min({a.vcap_mm_s, g.vcap_mm_s, a.end_cap_mm_s});
+        vj_[i] = std::min(bound, reachable_speed_mm_s(vj_[i + 1], g.length_mm, g.tangent));
     }
     // Forward pass: as fast as can be reached from where the last emitted record ended.
     vj_[0] = v_start_;
-    for (std::size_t i = 0; i < n; ++i) {
-        const Item& it = items_[head_ + i];
-        vj_[i + 1] =
-            std::min(vj_[i + 1], reachable_speed_mm_s(vj_[i], it.geom.length_mm, it.lim.tangent));
+    for (std::size_t i = 0; i < m; ++i) {
+        const Group& g = groups_[i];
+        vj_[i + 1] = std::min(vj_[i + 1], reachable_speed_mm_s(vj_[i], g.length_mm, g.tangent));
     }
-    std::size_t count = all ? n : n - std::min(n, cfg_.window / 2);
-    for (std::size_t i = 0; i < count; ++i) emit(items_[head_ + i], vj_[i], vj_[i + 1]);
-    head_ += count;
+    // Emit whole groups, keeping the last half of the window for the next round.
+    std::size_t keep = all ? 0 : std::min(n, cfg_.window / 2);
+    std::size_t count = 0, emitted = 0;
+    while (count < m && groups_[count].end - head_ <= n - keep) {
+        emit_group(groups_[count], vj_[count], vj_[count + 1]);
+        emitted += groups_[count].end - groups_[count].first;
+        ++count;
+    }
+    head_ += emitted;
     v_start_ = vj_[count];
     if (head_ == items_.size()) {
         items_.clear();
@@ -214,22 +262,82 @@ std::size_t Planner::plan_and_emit(bool all) {
         items_.erase(items_.begin(), items_.begin() + static_cast<std::ptrdiff_t>(head_));
         head_ = 0;
     }
-    return count;
+    return emitted;
 }
 
-void Planner::emit(const Item& it, double v_in, double v_out) {
-    PreparedSegment rec;
+namespace {
+
+// Time at which the profile reaches s (profiles are monotone in s).
+double time_at(const Profile1D& p, double s) {
+    double lo = 0, hi = p.duration_s;
+    for (int i = 0; i < 60 && hi - lo > 1e-15; ++i) {
+        double mid = (lo + hi) / 2;
+        (p.at(mid).s_mm < s ? lo : hi) = mid;
+    }
+    return (lo + hi) / 2;
+}
+
+// The part of p between times ta and tb, shifted to start at time 0 and position 0.
+Profile1D clip(const Profile1D& p, double ta, double tb, double sa) {
+    Profile1D out;
+    for (int i = 0; i < p.count; ++i) {
+        const ProfilePhase& ph = p.phases[i];
+        double end = i + 1 < p.count ? p.phases[i + 1].t0_s : p.duration_s;
+        if (end <= ta || ph.t0_s >= tb) continue;
+        double start = std::max(ph.t0_s, ta);
+        double dt = start - ph.t0_s;
+        ProfilePhase& q = out.phases[out.count++];
+        q.t0_s = start - ta;
+        q.s0_mm = ph.s0_mm + ph.v0_mm_s * dt + ph.a0_mm_s2 * dt * dt / 2 +
+                  ph.j_mm_s3 * dt * dt * dt / 6 - sa;
+        q.v0_mm_s = ph.v0_mm_s + ph.a0_mm_s2 * dt + ph.j_mm_s3 * dt * dt / 2;
+        q.a0_mm_s2 = ph.a0_mm_s2 + ph.j_mm_s3 * dt;
+        q.j_mm_s3 = ph.j_mm_s3;
+    }
+    out.duration_s = tb - ta;
+    return out;
+}
+
+}  // namespace
+
+void Planner::emit_group(const Group& g, double v_in, double v_out) {
+    Profile1D prof = build_profile(g.length_mm, v_in, v_out, g.vcap_mm_s, g.tangent);
+    if (g.end - g.first == 1) {
+        emit(items_[g.first], prof);
+        return;
+    }
+    // One profile over the whole group, cut at the element boundaries: the acceleration runs on
+    // across them instead of returning to zero at each.
+    double s = 0, t = 0;
+    for (std::size_t i = g.first; i < g.end; ++i) {
+        const Item& it = items_[i];
+        double s_end = s + it.geom.length_mm;
+        double t_end = i + 1 == g.end ? prof.duration_s : time_at(prof, s_end);
+        emit(it, clip(prof, t, t_end, s));
+        s = s_end;
+        t = t_end;
+    }
+}
+
+void Planner::emit(const Item& it, const Profile1D& prof) {
+    if (out_head_ == out_.size()) {
+        out_.clear();
+        out_head_ = 0;
+    }
+    PreparedSegment& rec = out_.emplace_back();
     rec.geom = it.geom;
-    rec.profile = build_profile(it.geom.length_mm, v_in, v_out, it.lim.vcap_mm_s, it.lim.tangent);
+    rec.profile = prof;
     LimitShares rate_share{1 - cfg_.override_reserve, 1 - cfg_.override_reserve};
     ElementBounds b = bounds(it.geom);
-    const Profile1D& prof = rec.profile;
     for (int i = 0; i < prof.count; ++i) {
         // Peaks of a cubic phase are at its ends (|v| and |a| are monotone within a phase).
         const ProfilePhase& ph = prof.phases[i];
         double dt = (i + 1 < prof.count ? prof.phases[i + 1].t0_s : prof.duration_s) - ph.t0_s;
         double v = std::max(ph.v0_mm_s, ph.v0_mm_s + ph.a0_mm_s2 * dt + ph.j_mm_s3 * dt * dt / 2);
         double a = std::max(std::fabs(ph.a0_mm_s2), std::fabs(ph.a0_mm_s2 + ph.j_mm_s3 * dt));
+        rec.profile.peak_v_mm_s = std::max(rec.profile.peak_v_mm_s, v);
+        rec.profile.peak_a_mm_s2 = std::max(rec.profile.peak_a_mm_s2, a);
+        rec.profile.peak_j_mm_s3 = std::max(rec.profile.peak_j_mm_s3, std::fabs(ph.j_mm_s3));
         // Next to a junction that is not smooth the step there scales with the rate: stay at 1.
         rec.phase_rate_cap[i] = it.rough ? 1.0
                                          : rate_cap(b, cfg_.limits, v, a, std::fabs(ph.j_mm_s3),
@@ -237,11 +345,6 @@ void Planner::emit(const Item& it, double v_in, double v_out) {
     }
     rec.line = it.line;
     rec.seq = seq_++;
-    if (out_head_ == out_.size()) {
-        out_.clear();
-        out_head_ = 0;
-    }
-    out_.push_back(rec);
 }
 
 bool Planner::pop(PreparedSegment& out) noexcept {

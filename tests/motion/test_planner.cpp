@@ -93,6 +93,17 @@ TEST(Planner, JerkLimitedShortSegmentsAlsoReachFullFeed) {
     EXPECT_NEAR(vmax, 50, 1e-6);
 }
 
+TEST(Planner, JerkLimitedAccelerationRunsOnAcrossShortSegments) {
+    // 100 mm as 2000 collinear moves takes as long as one 100 mm move: the S-curve is planned
+    // over the run of elements, not restarted from zero acceleration in each 0.05 mm move.
+    PlannerConfig cfg = uniform(100, 1000, 1e4);
+    std::vector<PathSegment> segs;
+    for (int i = 1; i <= 2000; ++i) segs.push_back(line_to({0.05 * i}, 80, 0.01, i));
+    double t_split = total_time(plan(cfg, segs));
+    double t_whole = total_time(plan(cfg, {line_to({100}, 80)}));
+    EXPECT_NEAR(t_split, t_whole, 1e-6 * t_whole);
+}
+
 TEST(Planner, ExactPathStopsAtASharpCorner) {
     PlannerConfig cfg = uniform(100, 1000, 0);
     auto recs = plan(cfg, {line_to({10}, 50, 0), line_to({10, 10}, 50, 0)});

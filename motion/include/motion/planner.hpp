@@ -79,6 +79,14 @@ class Planner {
         bool rough;           // next to a junction that is not smooth
         std::int32_t line;
     };
+    // Consecutive elements planned as one profile (jerk-limited mode; otherwise one each).
+    struct Group {
+        std::size_t first, end;  // item indices [first, end)
+        double length_mm;
+        double vcap_mm_s;
+        double end_cap_mm_s;
+        TangentLimits tangent;
+    };
     struct Junction {
         double cap_mm_s;
         bool rough;
@@ -89,8 +97,10 @@ class Planner {
     void close_piece(Piece& p, Piece* next);
     void add_item(const Element& e, double feed, double end_cap, bool rough, std::int32_t line);
     std::size_t plan_and_emit(bool all);  // returns how many records it emitted
-    void emit(const Item& it, double v_in, double v_out);
-    double junction_bound(std::size_t i) const;
+    bool can_join(const Group& g, const Item& it) const;
+    void build_groups();
+    void emit_group(const Group& g, double v_in, double v_out);
+    void emit(const Item& it, const Profile1D& prof);
 
     PlannerConfig cfg_;
     AxisArray last_end_;
@@ -99,6 +109,7 @@ class Planner {
     std::vector<Item> items_;
     std::size_t head_ = 0;
     double v_start_ = 0;
+    std::vector<Group> groups_;
     std::vector<double> vj_;
     std::vector<PreparedSegment> out_;
     std::size_t out_head_ = 0;
