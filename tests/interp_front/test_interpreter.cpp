@@ -304,6 +304,17 @@ TEST_F(InterpFixture, ProgramSubprogramWinsOverLibrary) {
     EXPECT_EQ(exec.values('X'), (Values{5}));
 }
 
+// The dialect is chosen per program: the same interpreter reads V5.4 syntax after switching.
+TEST_F(InterpFixture, DialectChosenPerProgram) {
+    Interpreter& in = start("#1=2^3\n");
+    EXPECT_THROW(in.run(), Error);  // ^ is not an operator of the 6th edition
+    in.open(Source::from_string("v54.nc", "#1=2^3\nG0 X=#1 Y=#SSCURPOS0\n"),
+            &ncstudio_v54_dialect());
+    in.run();
+    EXPECT_EQ(exec.values('X'), (Values{8}));
+    EXPECT_EQ(in.dialect().name, "ncstudio-v54");
+}
+
 // No globals: two interpreters interleaved keep their own variables, stacks and positions.
 TEST(InterpreterIsolation, TwoInterpretersSideBySide) {
     test::FakeMachine m1, m2;

@@ -49,9 +49,10 @@ class Interpreter {
     void load_library(const std::string& path);
     void set_library(std::unique_ptr<Source> library);
 
-    // Starts a program (resets the call stack and the variables).
-    void open(const std::string& path);
-    void open(std::unique_ptr<Source> program);
+    // Starts a program (resets the call stack and the variables). The dialect is chosen per
+    // program: `dialect` overrides the one in the options for this and later programs.
+    void open(const std::string& path, const Dialect* dialect = nullptr);
+    void open(std::unique_ptr<Source> program, const Dialect* dialect = nullptr);
 
     // Interprets one source line. Returns false once the program has ended. Throws Error for a
     // bad line; that line changes nothing, and calling step() again continues with the next

@@ -37,6 +37,11 @@ class BlockParser {
     BlockParser(const Dialect& dialect, Variables& vars, MachineQuery& machine)
         : dialect_(&dialect), lexer_(dialect), vars_(vars), machine_(machine) {}
 
+    void set_dialect(const Dialect& dialect) {
+        dialect_ = &dialect;
+        lexer_ = Lexer(dialect);
+    }
+
     // Throws Error (file:line:col) on any syntax or evaluation error. `out` is reset first.
     void parse(std::string_view line, const SourceLoc& loc, ParsedLine& out);
 

@@ -83,11 +83,15 @@ void Interpreter::set_library(std::unique_ptr<Source> library) {
     library_ = std::move(library);
 }
 
-void Interpreter::open(const std::string& path) {
-    open(Source::open_file(path));
+void Interpreter::open(const std::string& path, const Dialect* dialect) {
+    open(Source::open_file(path), dialect);
 }
 
-void Interpreter::open(std::unique_ptr<Source> program) {
+void Interpreter::open(std::unique_ptr<Source> program, const Dialect* dialect) {
+    if (dialect != nullptr) {
+        options_.dialect = dialect;
+        parser_.set_dialect(*dialect);
+    }
     main_ = std::move(program);
     current_ = main_.get();
     stack_.clear();
