@@ -30,10 +30,11 @@ struct Edge : hal::Instance {
             time_left_ns = out_width_ns.get();
             pulse = true;
         } else if (time_left_ns > 0) {
-            // The pulse covers the period in which time was still left, as LinuxCNC's does.
+            // The period just run is spent: the pulse continues only if time is still left, so
+            // it lasts ceil(out-width-ns / period) runs, at least one (measured on LinuxCNC 2.9).
             const std::int64_t left = std::int64_t{time_left_ns} - period.ns;
-            time_left_ns = static_cast<std::int32_t>(left < INT32_MIN ? INT32_MIN : left);
-            pulse = true;
+            pulse = left > 0;
+            time_left_ns = pulse ? static_cast<std::int32_t>(left) : 0;
         } else {
             time_left_ns = 0;
             pulse = false;
