@@ -315,6 +315,97 @@ TEST_F(InterpFixture, DialectChosenPerProgram) {
     EXPECT_EQ(in.dialect().name, "ncstudio-v54");
 }
 
+// S0 §3.5.1 G992 array, method 1 (EX-01), with the user's part reduced to one drilling move:
+// O3455 runs #4=30 times and calls O3456 #3=30 times each, so the part runs 900 times, and
+// every O3456 run ends with the X step G00 G90 X=#1 (X30).
+TEST_F(InterpFixture, ManualG992ArrayCallStructure) {
+    run("#1=30      'X offset\n"
+        "#2=40      'Y offset\n"
+        "#3=30      'items in X\n"
+        "#4=30      'items in Y\n"
+        "G65 P3455 L=#4\n"
+        "G00 G90 X=-#1*#3 Y=-#2*#4\n"
+        "G992 X0 Y0\n"
+        "M30\n"
+        "O3455\n"
+        "G65 P3456 L=#3\n"
+        "G00 G90 X=-#1*#3 Y=#2\n"
+        "G906\n"
+        "G992 X0 Y0\n"
+        "M17\n"
+        "O3456\n"
+        "G81 X5 Y5 Z-1 R1 F100\n"
+        "G00 G90 X=#1\n"
+        "G906\n"
+        "G992 X0\n"
+        "M17\n");
+    int part = 0, x_steps = 0, row_steps = 0;
+    for (const Block& b : exec.blocks) {
+        if (b.loc.line == 16) ++part;
+        if (b.loc.line == 17 && b.get('X') == 30.0) ++x_steps;
+        if (b.loc.line == 11 && b.get('X') == -900.0 && b.get('Y') == 40.0) ++row_steps;
+    }
+    EXPECT_EQ(part, 900);
+    EXPECT_EQ(x_steps, 900);
+    EXPECT_EQ(row_steps, 30);
+    EXPECT_EQ(exec.blocks.back().loc.line, 8);                         // M30
+    EXPECT_EQ(exec.blocks[exec.blocks.size() - 3].get('Y'), -1200.0);  // -#2*#4
+}
+
+// S0 §3.12 example 5 (EX-22): G65 P9001 L6 runs the loop six times; subprogram after M30.
+TEST_F(InterpFixture, ManualExample5SubprogramAfterM30) {
+    run("N01 G92 X0 Y0 Z0\nN02 G65 P9001 L6\nN03 G90 G00 Z12\nN04 M30\n"
+        "O9001\nN10 G91 G01 Z-2 F100\nN20 X60\nN30 Y50\nN40 X-60\nN50 Y-50\nN60 M17\n");
+    EXPECT_EQ(exec.values('Z'), (Values{0, -2, -2, -2, -2, -2, -2, 12}));
+    EXPECT_EQ(exec.blocks.size(), 1u + 6 * 5 + 2);
+}
+
+// S0 §4.1.1 example 1 (EX-24): the G53 move to the fixed point runs only when ENABLE_CTP is set.
+TEST_F(InterpFixture, ManualNamedParameterExample) {
+    const std::string prog =
+        "G65 P1000\nM30\n"
+        "O1000      ' coolant, tool change\n"
+        "M901 H=#COOLANT_START_PORT P1\n"
+        "G04 P10\n"
+        "IF(#ENABLE_CTP) G53 G00 G90 X=#CTP_POS. X Y=#CTP_POS. Y Z=#CTP_POS. Z\n"
+        "' go to the tool-change position\n"
+        "G00 G90 Z10 ' or just lift\n"
+        "M05\n"
+        "M17\n";
+    machine.settings = {{"COOLANT_START_PORT", 24},
+                        {"ENABLE_CTP", 1},
+                        {"CTP_POS.X", 100},
+                        {"CTP_POS.Y", 200},
+                        {"CTP_POS.Z", -5}};
+    run(prog);
+    EXPECT_EQ(exec.values('H'), (Values{24}));
+    EXPECT_EQ(exec.values('X'), (Values{100}));
+    EXPECT_EQ(exec.values('Z'), (Values{-5, 10}));
+    ASSERT_EQ(exec.blocks.size(), 6u);
+    EXPECT_TRUE(exec.blocks[2].has_g(530));
+    exec.blocks.clear();
+    machine.settings["ENABLE_CTP"] = 0;
+    run(prog);
+    EXPECT_EQ(exec.values('X'), (Values{}));
+    EXPECT_EQ(exec.blocks.size(), 5u);
+}
+
+// S1 §3.5 example 4 (EX-34): #2 #3 #4 set in the parameter window, then G00 X=#2 Y=#3 Z=#4.
+TEST_F(InterpFixture, ManualV54ParameterWindowExample) {
+    options.dialect = &ncstudio_v54_dialect();
+    Interpreter& in =
+        start("G=1+2 X1 Y1 R1\nG00 X=#2 Y=#3 Z=#4 \xE2\x80\x99#2 #3 #4 from the UI\n");
+    in.variables().set_numbered(2, 5, {});
+    in.variables().set_numbered(3, 8, {});
+    in.variables().set_numbered(4, 2, {});
+    in.run();
+    ASSERT_EQ(exec.blocks.size(), 2u);
+    EXPECT_EQ(exec.blocks[0].g[0], 30);  // G=1+2 is G3
+    EXPECT_EQ(exec.blocks[1].get('X'), 5.0);
+    EXPECT_EQ(exec.blocks[1].get('Y'), 8.0);
+    EXPECT_EQ(exec.blocks[1].get('Z'), 2.0);
+}
+
 // No globals: two interpreters interleaved keep their own variables, stacks and positions.
 TEST(InterpreterIsolation, TwoInterpretersSideBySide) {
     test::FakeMachine m1, m2;

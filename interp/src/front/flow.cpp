@@ -102,6 +102,8 @@ std::string program_label(std::int64_t number, const std::optional<std::string>&
 FlowWords take_flow_words(ParsedLine& line, const Dialect& d) {
     FlowWords flow;
     Block& b = line.block;
+    // Most blocks carry no control word: skip the searches below for them.
+    if (b.m.empty() && !b.g.contains(kG65) && !line.p_name) return flow;
     const int g65_col = take_code(b.g, b.g_col, kG65);
     const int m98_col = take_code(b.m, b.m_col, 98);
     const int m17_col = take_code(b.m, b.m_col, d.sub_end_m);

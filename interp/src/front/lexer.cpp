@@ -195,7 +195,10 @@ void Lexer::lex(std::string_view s, const SourceLoc& loc, std::vector<Token>& ou
             continue;
         }
         if (c == ';') break;
-        if (d.quote_comments && comment_quote_length(s.substr(i)) != 0) break;
+        // Comment quotes are ' and a UTF-8 sequence starting 0xE2: test the byte first.
+        if (d.quote_comments && (c == '\'' || c == '\xE2') &&
+            comment_quote_length(s.substr(i)) != 0)
+            break;
         // Built in place: copying a finished Token into the vector stalls on store forwarding.
         Token& tok = out.emplace_back();
         tok.col = static_cast<int>(i) + 1;
