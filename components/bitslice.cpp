@@ -12,7 +12,7 @@ constexpr long kMaxBits = 32;
 std::size_t bit_count(const hal::Instance& self) {
     const long bits = self.arg_int("personality", kMaxBits);
     if (bits < 1 || bits > kMaxBits)
-        throw hal::Error("bitslice: personality=" + std::to_string(bits) + " for " +
+        throw hal::Error("personality=" + std::to_string(bits) + " for " +
                          std::string(self.name()) + " is out of range: give 1 to 32 bits");
     return static_cast<std::size_t>(bits);
 }
