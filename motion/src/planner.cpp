@@ -267,14 +267,37 @@ std::size_t Planner::plan_and_emit(bool all) {
 
 namespace {
 
-// Time at which the profile reaches s (profiles are monotone in s).
+// Time at which the profile reaches s (profiles are monotone in s): find the phase, then
+// regula falsi (Illinois) on its cubic.
 double time_at(const Profile1D& p, double s) {
-    double lo = 0, hi = p.duration_s;
-    for (int i = 0; i < 60 && hi - lo > 1e-15; ++i) {
-        double mid = (lo + hi) / 2;
-        (p.at(mid).s_mm < s ? lo : hi) = mid;
+    int i = p.count - 1;
+    while (i > 0 && p.phases[i].s0_mm > s) --i;
+    const ProfilePhase& ph = p.phases[i];
+    auto pos = [&](double dt) {
+        return ph.s0_mm + ph.v0_mm_s * dt + ph.a0_mm_s2 * dt * dt / 2 +
+               ph.j_mm_s3 * dt * dt * dt / 6 - s;
+    };
+    double lo = 0, hi = (i + 1 < p.count ? p.phases[i + 1].t0_s : p.duration_s) - ph.t0_s;
+    double flo = pos(lo), fhi = pos(hi);
+    if (fhi <= 0) return ph.t0_s + hi;
+    int side = 0;
+    for (int k = 0; k < 100 && hi - lo > 1e-15; ++k) {
+        double x = (lo * fhi - hi * flo) / (fhi - flo);
+        if (!(x > lo && x < hi)) x = (lo + hi) / 2;
+        double f = pos(x);
+        if (f == 0) return ph.t0_s + x;
+        if (f < 0) {
+            lo = x, flo = f;
+            if (side == -1) fhi /= 2;
+            side = -1;
+        } else {
+            hi = x, fhi = f;
+            if (side == 1) flo /= 2;
+            side = 1;
+        }
+        if (std::fabs(f) < 1e-13 * std::max(1.0, s)) return ph.t0_s + x;
     }
-    return (lo + hi) / 2;
+    return ph.t0_s + (lo + hi) / 2;
 }
 
 // The part of p between times ta and tb, shifted to start at time 0 and position 0.

@@ -64,6 +64,36 @@ class PhaseWriter {
     double t_ = 0, s_ = 0, v_ = 0, a_ = 0;
 };
 
+// The largest peak speed in [lo, hi] whose two ramps fit in length (jerk-limited). The ramp
+// distances grow with the peak speed; regula falsi with the Illinois modification keeps the
+// root bracketed and converges in a few steps where bisection needs fifty.
+double peak_speed_for_length(double length, double v_in, double v_out, double lo, double hi,
+                             const TangentLimits& lim) {
+    auto excess = [&](double vp) {
+        return ramp_distance_mm(v_in, vp, lim) + ramp_distance_mm(vp, v_out, lim) - length;
+    };
+    const double tol = 1e-12 * std::max(length, 1e-9);
+    double flo = excess(lo), fhi = excess(hi);
+    if (flo >= 0) return lo;
+    int side = 0;
+    for (int i = 0; i < 100 && hi - lo > 1e-14 * hi; ++i) {
+        double x = (lo * fhi - hi * flo) / (fhi - flo);
+        if (!(x > lo && x < hi)) x = (lo + hi) / 2;
+        double f = excess(x);
+        if (std::fabs(f) <= tol && f <= 0) return x;
+        if (f < 0) {
+            lo = x, flo = f;
+            if (side == -1) fhi /= 2;
+            side = -1;
+        } else {
+            hi = x, fhi = f;
+            if (side == 1) flo /= 2;
+            side = 1;
+        }
+    }
+    return lo;
+}
+
 }  // namespace
 
 PathState Profile1D::at(double t_s) const noexcept {
@@ -135,12 +165,7 @@ Profile1D build_profile(double length, double v_in, double v_out, double vcap,
             vpeak = std::sqrt((2 * a * length + v_in * v_in + v_out * v_out) / 2);
             vpeak = std::clamp(vpeak, lo, vcap);
         } else {
-            double hi = vpeak;
-            vpeak = lo;
-            for (int i = 0; i < 60 && hi - vpeak > 1e-12 * hi; ++i) {
-                double mid = (vpeak + hi) / 2;
-                (needed(mid) <= length ? vpeak : hi) = mid;
-            }
+            vpeak = peak_speed_for_length(length, v_in, v_out, lo, vpeak, lim);
         }
     }
     PhaseWriter w(prof);
