@@ -270,8 +270,10 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
 }  // namespace
 
 std::string nearest_name(std::string_view name, const std::vector<std::string>& candidates) {
+    // Two edits (one for short words) catch a typo or a swapped pair without proposing
+    // an unrelated name that merely shares a long instance prefix.
     std::string best;
-    std::size_t best_d = std::max<std::size_t>(2, name.size() / 4) + 1;
+    std::size_t best_d = (name.size() < 4 ? 1 : 2) + 1;
     for (auto& c : candidates) {
         if (c.size() > name.size() + best_d || name.size() > c.size() + best_d) continue;
         auto d = edit_distance(name, c);
@@ -599,11 +601,14 @@ void Runtime::load_component(const std::string& name, const std::vector<std::str
             ::dlclose(lib);
             throw Error(fmt::format("{} is not a HAL component: it has no cnc_hal_component entry point", path));
         }
+        // Only the first field is read before the version matches: it is the one field
+        // every ABI version keeps in place.
         const ComponentDescriptor* d = entry();
-        if (!d || d->abi_version != kAbiVersion) {
+        const std::uint32_t abi = d ? d->abi_version : 0;
+        if (abi != kAbiVersion) {
             ::dlclose(lib);
-            throw Error(fmt::format("{} was built for HAL ABI {}, this runtime is ABI {}; rebuild it",
-                                    path, d ? d->abi_version : 0, kAbiVersion));
+            throw Error(fmt::format("{} was built for HAL ABI {}, this runtime is ABI {}; rebuild it", path,
+                                    abi, kAbiVersion));
         }
         fresh = std::make_unique<Component>();
         fresh->name = name.find('/') != std::string::npos ? d->name : name;
@@ -685,6 +690,7 @@ void Runtime::load_component(const std::string& name, const std::vector<std::str
     auto shared_before = comp->shared_functs.size();
     std::vector<std::size_t> shared_sizes;
     for (auto& sf : comp->shared_functs) shared_sizes.push_back(sf->objects.size());
+    std::optional<std::string> failure;
     try {
         for (std::size_t i = 0; i < names.size(); ++i) {
             detail::InstanceContext ctx{this, &building, comp, names[i], static_cast<int>(i), &kv};
@@ -708,12 +714,17 @@ void Runtime::load_component(const std::string& name, const std::vector<std::str
             made.push_back(std::move(rec));
         }
     } catch (const std::exception& e) {
+        // The exception may have been made by the component, its vtable in the library:
+        // keep only its text, and unload the library after the handler has destroyed it.
+        failure = e.what();
         made.clear();
         building.rollback();
         comp->shared_functs.resize(shared_before);
         for (std::size_t i = 0; i < shared_sizes.size(); ++i) comp->shared_functs[i]->objects.resize(shared_sizes[i]);
+    }
+    if (failure) {
         close_fresh();
-        throw Error(e.what());
+        throw Error(*failure);
     }
     if (fresh) {
         ++next_component_id_;
@@ -745,8 +756,12 @@ void Runtime::unload_component(Component& c) {
         }
     }
     for (auto it = params_.begin(); it != params_.end();) {
-        if (it->second->component == &c) it = params_.erase(it);
-        else ++it;
+        if (it->second->component != &c) {
+            ++it;
+            continue;
+        }
+        if (!it->second->timing) segment_->release(it->second->slot, sizeof(Value));
+        it = params_.erase(it);
     }
     for (auto it = functs_.begin(); it != functs_.end();) {
         if (it->second->component == &c) {
@@ -766,8 +781,8 @@ void Runtime::unload_component(Component& c) {
         delete ctx->args;
         delete ctx;
     }
-    // Stream rings and param slots stay allocated until the instance ends: a client may
-    // still have them mapped, and a few KiB per unload is a fair price for that safety.
+    // Stream rings stay allocated until the instance ends: halsampler may still be draining
+    // one, and a ring reused under it would hand it another stream's records.
     for (auto it = streams_.begin(); it != streams_.end();) {
         bool owned = false;
         for (auto& inst : c.instances)

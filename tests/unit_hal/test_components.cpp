@@ -1,0 +1,94 @@
+// Components that exist only to exercise the runtime: every pin type, args, a shared
+// function, a stream, a constructor that fails half way, a function that overruns.
+#include <time.h>
+
+#include "hal/component.hpp"
+
+namespace {
+
+struct Probe : hal::Instance {
+    hal::In<bool> in_bit{this, "in-bit"};
+    hal::In<double> in_float{this, "in-float", 1.5};
+    hal::In<std::int32_t> in_s32{this, "in-s32", -3};
+    hal::In<std::uint32_t> in_u32{this, "in-u32"};
+    hal::In<std::int64_t> in_s64{this, "in-s64"};
+    hal::In<std::uint64_t> in_u64{this, "in-u64"};
+    hal::Out<double> out_float{this, "out-float"};
+    hal::Out<bool> out_bit{this, "out-bit"};
+    hal::IO<double> io_float{this, "io-float"};
+    hal::Out<std::uint64_t> cycles{this, "cycles"};
+    hal::Param<double> gain{this, "gain", 2.0};
+    hal::Param<std::int32_t> ro{this, "ro", 7, hal::ParamDir::RO};
+    hal::Array<hal::Out<std::int32_t>> taps{this, "tap-{:02}", static_cast<std::size_t>(arg_int("taps", 2))};
+    std::uint64_t count = 0;
+
+    Probe() { shared_function<&Probe::tick>("tick-all"); function<&Probe::update>(""); }
+    void update(hal::Period) noexcept {
+        out_float = in_float * gain;
+        out_bit = !in_bit;
+        cycles = ++count;
+        for (std::size_t i = 0; i < taps.size(); ++i) taps[i] = static_cast<std::int32_t>(i) + in_s32;
+    }
+    void tick(hal::Period) noexcept { ++count; }
+};
+
+struct Failing : hal::Instance {
+    hal::In<bool> a{this, "a"};
+    hal::Out<bool> b{this, "b"};
+    Failing() {
+        if (index() == arg_int("fail-at", -1)) throw hal::Error("refusing to build this instance");
+    }
+    void update(hal::Period) noexcept { b = a; }
+};
+
+struct Spinner : hal::Instance {
+    hal::Param<std::int64_t> spin_ns{this, "spin-ns", 0};
+    hal::Out<std::uint64_t> calls{this, "calls"};
+    std::uint64_t n = 0;
+    void update(hal::Period) noexcept {
+        // Busy-waits once for spin-ns, then clears it: a single deliberately late cycle.
+        std::int64_t spin = spin_ns;
+        if (spin > 0) {
+            timespec t0, t;
+            clock_gettime(CLOCK_MONOTONIC, &t0);
+            do clock_gettime(CLOCK_MONOTONIC, &t);
+            while ((t.tv_sec - t0.tv_sec) * 1'000'000'000LL + (t.tv_nsec - t0.tv_nsec) < spin);
+            spin_ns = 0;
+        }
+        calls = ++n;
+    }
+};
+
+struct Streamer : hal::Instance {
+    hal::Stream stream{this, std::string(name()), "fb", 8};
+    hal::In<double> value{this, "value"};
+    hal::Out<std::int32_t> pushed{this, "pushed"};
+    std::int32_t n = 0;
+    void update(hal::Period) noexcept {
+        hal::Value rec[2];
+        rec[0].f = value;
+        rec[1].b = (n % 2) == 0;
+        if (stream.push(rec)) pushed = ++n;
+    }
+};
+
+}  // namespace
+
+#if defined(TEST_COMPONENT_PROBE)
+HAL_COMPONENT(t_probe, Probe, "runtime test: every pin type", "taps")
+#elif defined(TEST_COMPONENT_FAILING)
+HAL_COMPONENT(t_failing, Failing, "runtime test: constructor failure", "fail-at")
+#elif defined(TEST_COMPONENT_SPINNER)
+HAL_COMPONENT(t_spinner, Spinner, "runtime test: late cycles")
+#elif defined(TEST_COMPONENT_STREAM)
+HAL_COMPONENT(t_stream, Streamer, "runtime test: stream producer")
+#elif defined(TEST_COMPONENT_BADABI)
+extern "C" __attribute__((visibility("default"))) const hal::ComponentDescriptor* cnc_hal_component() {
+    static const char* const args[] = {nullptr};
+    static const hal::ComponentDescriptor d{hal::kAbiVersion + 100, "t_badabi", "wrong ABI", args,
+                                            &hal::detail::create_instance<Probe>};
+    return &d;
+}
+#elif defined(TEST_COMPONENT_NOSYM)
+extern "C" int not_a_component() { return 0; }
+#endif
