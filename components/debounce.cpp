@@ -17,12 +17,11 @@ constexpr long kMaxFilters = 1000;
 
 std::size_t group_size(const hal::Instance& self) {
     if (!self.arg("cfg"))
-        throw hal::Error("debounce needs cfg=size[,size...]: one filter count per group");
+        throw hal::Error("cfg=size[,size...] is required: one filter count per group");
     const long size = self.arg_int("cfg", 0);
     if (size < 1 || size > kMaxFilters)
-        throw hal::Error("debounce: cfg item " + std::to_string(size) + " for group " +
-                         std::string(self.name()) + " must be from 1 to " +
-                         std::to_string(kMaxFilters));
+        throw hal::Error("cfg=" + std::to_string(size) + " for group " + std::string(self.name()) +
+                         ": a group has 1 to " + std::to_string(kMaxFilters) + " filters");
     return static_cast<std::size_t>(size);
 }
 

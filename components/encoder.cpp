@@ -57,6 +57,15 @@ std::uint32_t high_of(std::uint64_t w) noexcept {
 std::int32_t low_of(std::uint64_t w) noexcept {
     return static_cast<std::int32_t>(w & 0xFFFFFFFFu);
 }
+// Counts wrap around like the 32-bit hardware counters they model; signed overflow would be UB.
+std::int32_t wrapping_add(std::int32_t a, std::int32_t b) noexcept {
+    return static_cast<std::int32_t>(static_cast<std::uint32_t>(a) + static_cast<std::uint32_t>(b));
+}
+std::int32_t wrapping_sub(std::int32_t a, std::int32_t b) noexcept {
+    return static_cast<std::int32_t>(static_cast<std::uint32_t>(a) - static_cast<std::uint32_t>(b));
+}
+static_assert(std::atomic<std::uint64_t>::is_always_lock_free,
+              "update-counters and capture-position hand over events as lock-free 64-bit words");
 
 struct Encoder : hal::Instance {
     hal::In<bool> phase_a{this, "phase-A"};
@@ -100,10 +109,10 @@ struct Encoder : hal::Instance {
         }
         bool gap_index = false;
         if (state & kCountUp) {
-            raw_ += 1;
+            raw_ = wrapping_add(raw_, 1);
             if (counting) gap_index = missing_teeth_gap(now);
         } else if (state & kCountDown) {
-            raw_ -= 1;
+            raw_ = wrapping_sub(raw_, 1);
         }
         if (state & (kCountUp | kCountDown)) {
             count_event_.store(pack(now, raw_), std::memory_order_release);
@@ -153,12 +162,12 @@ struct Encoder : hal::Instance {
         const std::uint32_t now = timebase_.load(std::memory_order_acquire);
         estimate_velocity(now, min_speed);
 
-        const std::int32_t net = raw_count_ - index_count_;
+        const std::int32_t net = wrapping_sub(raw_count_, index_count_);
         counts = net;
         const double pos = net * scale_;
         position = pos;
         position_interpolated = pos + velocity_ * (now - timestamp_) * 1e-9;
-        const std::int32_t latched = latch_count_ - index_count_;
+        const std::int32_t latched = wrapping_sub(latch_count_, index_count_);
         counts_latched = latched;
         position_latched = latched * scale_;
         velocity = velocity_;
@@ -175,7 +184,7 @@ struct Encoder : hal::Instance {
         if (teeth <= 0 || !had_edge) return false;
         if (normal_interval_ns_ != 0 &&
             2.0 * interval > (teeth + 2.0) * static_cast<double>(normal_interval_ns_)) {
-            raw_ += teeth;
+            raw_ = wrapping_add(raw_, teeth);
             normal_interval_ns_ = interval / static_cast<std::uint32_t>(teeth + 1);
             return true;
         }
@@ -199,7 +208,7 @@ struct Encoder : hal::Instance {
         const std::uint64_t event = count_event_.load(std::memory_order_acquire);
         if (event != seen_count_event_) {
             seen_count_event_ = event;
-            const std::int32_t delta_counts = low_of(event) - raw_count_;
+            const std::int32_t delta_counts = wrapping_sub(low_of(event), raw_count_);
             const std::uint32_t delta_time = high_of(event) - timestamp_;
             raw_count_ = low_of(event);
             timestamp_ = high_of(event);

@@ -123,7 +123,9 @@ struct Pid : hal::Instance {
 
     Pid() {
         const long debug = arg_int("debug", 0);
-        if (debug < 0) throw hal::Error("pid: debug= must be 0 or 1");
+        if (debug < 0)  // LinuxCNC treats any positive value as 1
+            throw hal::Error("debug=" + std::to_string(debug) +
+                             ": must be 0 (off) or 1 (export the internal terms)");
         if (debug > 0) {
             // LinuxCNC exports the internal terms as output pins only with debug=1.
             debug_.emplace(this);

@@ -25,7 +25,7 @@ std::string sampler_layout(const hal::Instance& self) {
     auto cfg = self.arg("cfg");
     if (!cfg || cfg->empty())
         throw hal::Error(
-            "sampler needs cfg=LETTERS[,LETTERS...]: one letter per pin "
+            "cfg=LETTERS[,LETTERS...] is required: one letter per pin "
             "(b bit, f float, s s32, u u32, l s64, k u64)");
     return *cfg;
 }
@@ -33,7 +33,7 @@ std::string sampler_layout(const hal::Instance& self) {
 std::uint32_t sampler_depth(const hal::Instance& self) {
     const long depth = self.arg_int("depth", 0);
     if (depth < 1 || depth > (1L << 24))
-        throw hal::Error("sampler needs depth=N (records, 1 to 16777216) for " +
+        throw hal::Error("depth=N (records, 1 to 16777216) is required for " +
                          std::string(self.name()));
     return static_cast<std::uint32_t>(depth);
 }
@@ -64,7 +64,7 @@ SampledPin make_sampled_pin(hal::Instance* owner, hal::Type type, std::size_t co
         case hal::Type::U64:
             return make_pin<std::uint64_t>(owner, name);
     }
-    throw hal::Error("sampler: unknown field type");
+    throw hal::Error("unknown field type");
 }
 
 struct Sampler : hal::Instance {
