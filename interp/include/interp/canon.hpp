@@ -86,6 +86,7 @@ struct SetSpindleSpeed {
 struct Spindle {  // M03 / M04 / M05
     SpindleDir dir = SpindleDir::Stop;
 };
+struct SpindleOrient {};  // oriented spindle stop (inside G76/G87)
 struct Coolant {  // M08 / M09
     bool flood = false;
 };
@@ -174,7 +175,7 @@ struct ProgramEnd {
 using CanonCommand =
     std::variant<canon::Traverse, canon::FeedLine, canon::Arc, canon::SetFeedRate,
                  canon::SetRapidRate, canon::SetFeedMode, canon::Dwell, canon::SetSpindleSpeed,
-                 canon::Spindle, canon::Coolant, canon::SpindleClamp, canon::ToolChange,
+                 canon::Spindle, canon::SpindleOrient, canon::Coolant, canon::SpindleClamp, canon::ToolChange,
                  canon::SetToolNumber, canon::ToolOffset, canon::Offsets, canon::SelectPlane,
                  canon::Units, canon::SetOutput, canon::WaitInput, canon::Sync,
                  canon::ConditionalMove, canon::LatchConfig, canon::LatchClear,

@@ -14,6 +14,7 @@
 
 #include "interp/block.hpp"
 #include "interp/canon.hpp"
+#include "interp/cycles.hpp"
 #include "interp/modal.hpp"
 #include "interp/persist.hpp"
 #include "interp/transform.hpp"
@@ -41,6 +42,7 @@ struct BackendConfig {
     std::array<std::optional<double>, 3> g904_trip_mm{};
     // Machine settings readable as named parameters (SAFEHEIGHT, MOBICALI_THICKNESS, …), mm.
     std::map<std::string, double, std::less<>> machine_settings;
+    cycles::CycleConfig cycles;  // canned-cycle machine parameters (FIXEDCYCLE_BACK, …)
 };
 
 // Everything the executor keeps between blocks apart from settings and transforms.
@@ -54,6 +56,8 @@ struct ExecState {
     CoordModal coord;
     Position pos;
     IoState io;
+    cycles::CycleState cycle;      // active canned cycle and its modal data (G80 = none)
+    bool cycle_return_to_r = false;  // G99 (else G98)
     bool started = false;  // the initial offsets have been announced
 };
 
@@ -72,9 +76,7 @@ public:
     double spindle_rpm() override;
     double mm_per_program_unit() override { return state_.units.mm_per_unit; }
     bool incremental_mode() override { return state_.motion.incremental; }
-    // G98/G99 belong to the canned cycles, which this executor does not run yet (they are an
-    // error here), so the return mode is always the G98 default.
-    bool cycle_return_to_r() override { return false; }
+    bool cycle_return_to_r() override { return state_.cycle_return_to_r; }
     std::optional<double> setting(std::string_view name) override;
 
     // Called after every committed block that changed a persistent setting (for saving).

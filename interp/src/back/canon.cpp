@@ -81,6 +81,7 @@ struct TextVisitor {
             default: return "spindle stop";
         }
     }
+    std::string operator()(const canon::SpindleOrient&) const { return "spindle-orient"; }
     std::string operator()(const canon::Coolant& c) const {
         return c.flood ? "coolant on" : "coolant off";
     }

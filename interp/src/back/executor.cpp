@@ -12,6 +12,7 @@
 #include <numbers>
 
 #include "interp/arc.hpp"
+#include "interp/hole_patterns.hpp"
 
 namespace interp {
 
@@ -29,6 +30,8 @@ enum class GGroup {
     Rotation,
     NonModal,
     FeedMode,
+    Cycle,       // G73 … G89, G80
+    CycleReturn, // G98 / G99
     Flag,
 };
 
@@ -59,6 +62,16 @@ constexpr GInfo kGTable[] = {
     {gcode(904), GGroup::NonModal, true},  {gcode(905), GGroup::Flag, false},
     {gcode(906), GGroup::NonModal, false}, {gcode(907), GGroup::Flag, false},
     {gcode(908), GGroup::Flag, false},     {gcode(916), GGroup::NonModal, false},
+    {gcode(73), GGroup::Cycle, false},     {gcode(74), GGroup::Cycle, false},
+    {gcode(76), GGroup::Cycle, false},     {gcode(80), GGroup::Cycle, false},
+    {gcode(81), GGroup::Cycle, false},     {gcode(82), GGroup::Cycle, false},
+    {gcode(83), GGroup::Cycle, false},     {gcode(84), GGroup::Cycle, false},
+    {gcode(85), GGroup::Cycle, false},     {gcode(86), GGroup::Cycle, false},
+    {gcode(87), GGroup::Cycle, false},     {gcode(88), GGroup::Cycle, false},
+    {gcode(89), GGroup::Cycle, false},     {gcode(98), GGroup::CycleReturn, false},
+    {gcode(99), GGroup::CycleReturn, false}, {gcode(34), GGroup::NonModal, true},
+    {gcode(35), GGroup::NonModal, true},   {gcode(36), GGroup::NonModal, true},
+    {gcode(37), GGroup::NonModal, true},   {gcode(40), GGroup::Flag, false},
     {gcode(918), GGroup::NonModal, false}, {gcode(919), GGroup::NonModal, false},
     {gcode(921), GGroup::NonModal, true},  {gcode(922), GGroup::NonModal, true},
     {gcode(923), GGroup::NonModal, true},  {gcode(992), GGroup::NonModal, true},
@@ -146,6 +159,7 @@ private:
     void step_transforms();
     void step_settings_writes();
     void step_machine_codes();
+    void step_cycle_modes();
     void step_motion();
     void step_stop();
 
@@ -224,6 +238,11 @@ private:
     void write_g992();
     void shift_by_current_point(AxisVec& offset);
     void program_end(bool rewind);
+    cycles::BlockContext cycle_context() const;
+    cycles::CycleWords cycle_words() const;
+    void run_cycle();
+    void run_hole_pattern();
+    void emit_cycle_steps(const cycles::Expansion& e);
 
     const Block& b_;
     const BackendConfig& cfg_;
@@ -232,6 +251,7 @@ private:
     std::vector<Canon>& out_;
     canon::MoveFlags flags_;
     std::optional<int> motion_code_;  // G00..G03 written in this block
+    std::optional<int> cycle_code_;   // G73..G89 or G80 written in this block
     const GInfo* axis_user_ = nullptr;
 };
 
@@ -242,7 +262,8 @@ const BlockRun::Step BlockRun::kSteps[] = {
     &BlockRun::step_dwell,     &BlockRun::step_plane,         &BlockRun::announce_units,
     &BlockRun::step_tool_length,
     &BlockRun::step_wcs,       &BlockRun::step_distance,      &BlockRun::step_transforms,
-    &BlockRun::step_settings_writes, &BlockRun::step_machine_codes, &BlockRun::step_motion,
+    &BlockRun::step_settings_writes, &BlockRun::step_machine_codes, &BlockRun::step_cycle_modes,
+    &BlockRun::step_motion,
     &BlockRun::step_stop,
 };
 
@@ -271,6 +292,7 @@ void BlockRun::validate() {
             seen_group[grp] = code;
         }
         if (info->group == GGroup::Motion) motion_code_ = code;
+        if (info->group == GGroup::Cycle) cycle_code_ = code;
         if (info->uses_axes) {
             if (axis_user_)
                 fail(loc, fmt::format("{} and {} both use the axis words", gname(axis_user_->code),
@@ -281,6 +303,13 @@ void BlockRun::validate() {
     if (axis_user_ && motion_code_)
         fail(loc_g(*motion_code_), fmt::format("{} and {} both use the axis words",
                                                gname(axis_user_->code), gname(*motion_code_)));
+    if (motion_code_ && cycle_code_ && *cycle_code_ != gcode(80))
+        fail(loc_g(*cycle_code_), fmt::format("{} and {} cannot share a block",
+                                              gname(*motion_code_), gname(*cycle_code_)));
+    if (axis_user_ && cycle_code_ && *cycle_code_ != gcode(80) &&
+        !(axis_user_->code >= gcode(34) && axis_user_->code <= gcode(37)))
+        fail(loc_g(*cycle_code_), fmt::format("{} and {} both use the axis words",
+                                              gname(axis_user_->code), gname(*cycle_code_)));
     std::array<int, 8> seen_m;
     seen_m.fill(-1);
     for (std::size_t i = 0; i < b_.m.size(); ++i) {
@@ -395,8 +424,12 @@ void BlockRun::step_feed() {
     const double f = b_.get('F');
     if (f < 0) fail(b_.loc_of('F'), fmt::format("negative feed rate F{}", fmt_num(f)));
     const double f_mm_s = f * st.units.mm_per_unit / 60.0;
+    // A canned-cycle block's F is the drilling feed even though G00 is the modal motion.
+    const bool cycle_block =
+        (cycle_code_ && *cycle_code_ != gcode(80)) || (st.cycle.active() && !motion_code_);
     const bool rapid_mode =
-        motion_code_ ? *motion_code_ == gcode(0) : st.motion.motion == Motion::Rapid;
+        !cycle_block &&
+        (motion_code_ ? *motion_code_ == gcode(0) : st.motion.motion == Motion::Rapid);
     if (rapid_mode && !g(gcode(904))) {
         double r = f_mm_s;
         if (cfg_.max_rapid_mm_s > 0) r = std::min(r, cfg_.max_rapid_mm_s);
@@ -1022,7 +1055,12 @@ void BlockRun::move_arc(bool ccw) {
 }
 
 void BlockRun::step_motion() {
+    if (axis_user_ && axis_user_->code >= gcode(34) && axis_user_->code <= gcode(37))
+        return run_hole_pattern();
     if (axis_user_) return;  // G92, G28, G51 … consumed the axis words
+    if (motion_code_) st.cycle.cancel();  // G00-8, G01-5: a group-01 code ends the cycle
+    if (!motion_code_ && (st.cycle.active() || (cycle_code_ && *cycle_code_ != gcode(80))))
+        return run_cycle();
     if (motion_code_) st.motion.motion = static_cast<Motion>(*motion_code_ / 10);
     const bool arc_mode = st.motion.motion == Motion::ArcCw || st.motion.motion == Motion::ArcCcw;
     // ARC-4: an arc block with I/J/K and no end point is a full circle (S4 `G03 I-20 J0`).
@@ -1047,10 +1085,142 @@ void BlockRun::step_motion() {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Canned cycles (G73–G89) and hole patterns (G34–G37): the cycles core expands a block into simple
+// steps in program coordinates; they are transformed and emitted here like any other move.
+
+void BlockRun::step_cycle_modes() {
+    if (g(gcode(98))) st.cycle_return_to_r = false;
+    if (g(gcode(99))) st.cycle_return_to_r = true;
+    if (g(gcode(80))) st.cycle.cancel();
+}
+
+cycles::BlockContext BlockRun::cycle_context() const {
+    cycles::BlockContext c;
+    c.incremental = st.motion.incremental;
+    c.return_to_r = st.cycle_return_to_r;
+    c.position_mm = {st.pos.prog_mm[0], st.pos.prog_mm[1], st.pos.prog_mm[2]};
+    c.feed_mm_min = st.feed.feed_mm_s * 60.0;
+    c.spindle_rpm = st.spindle.rpm;
+    c.spindle = st.spindle.dir == SpindleDir::Cw    ? cycles::Spindle::Cw
+                : st.spindle.dir == SpindleDir::Ccw ? cycles::Spindle::Ccw
+                                                    : cycles::Spindle::Stopped;
+    c.plane = st.motion.plane == Plane::ZX   ? cycles::Plane::ZX
+              : st.motion.plane == Plane::YZ ? cycles::Plane::YZ
+                                             : cycles::Plane::XY;
+    c.drill_axis_scaled = std::abs(xf().matrix().linear().col(2).norm() - 1.0) > 1e-12;
+    return c;
+}
+
+cycles::CycleWords BlockRun::cycle_words() const {
+    cycles::CycleWords w;
+    for (int a = 0; a < 3; ++a)
+        if (has_axis(a)) w.axis_mm[a] = axis_value(a);
+    if (b_.has('R')) w.r_mm = mm('R');
+    if (b_.has('Q')) w.q_mm = mm('Q');
+    if (b_.has('P')) w.p_ms = b_.get('P');
+    // C-14: NcStudio documents K and uses L in its examples; both are the repeat count.
+    if (b_.has('K')) w.k = std::lround(b_.get('K'));
+    else if (b_.has('L')) w.k = std::lround(b_.get('L'));
+    return w;
+}
+
+void BlockRun::run_cycle() {
+    if (!st.feed.feed_set) require_feed("a canned cycle");
+    std::optional<cycles::CycleCode> code;
+    if (cycle_code_ && *cycle_code_ != gcode(80)) code = cycles::cycle_code_from_g(*cycle_code_ / 10);
+    try {
+        const cycles::Expansion e =
+            st.cycle.run_block(code, cycle_words(), cycle_context(), cfg_.cycles);
+        emit_cycle_steps(e);
+    } catch (const cycles::CycleError& e) {
+        fail(cycle_code_ ? loc_g(*cycle_code_) : b_.loc, e.what());
+    }
+}
+
+void BlockRun::run_hole_pattern() {
+    const int code = axis_user_->code;
+    cycles::PatternWords w;
+    if (has_axis(0)) w.x_mm = axis_value(0);
+    if (has_axis(1)) w.y_mm = axis_value(1);
+    // I is a length for every pattern; J is an angle except in G37, where it is the row pitch.
+    if (b_.has('I')) w.i = mm('I');
+    if (b_.has('J')) w.j = code == gcode(37) ? mm('J') : b_.get('J');
+    if (b_.has('P')) w.p = b_.get('P');
+    if (b_.has('K')) w.k = std::lround(b_.get('K'));
+    try {
+        const auto holes = cycles::hole_pattern(code / 10, w, st.motion.incremental,
+                                                {st.pos.prog_mm[0], st.pos.prog_mm[1]},
+                                                st.cycle.active());
+        emit_cycle_steps(st.cycle.drill_at(holes, cycle_context(), cfg_.cycles));
+    } catch (const cycles::CycleError& e) {
+        fail(loc_g(code), e.what());
+    }
+}
+
+void BlockRun::emit_cycle_steps(const cycles::Expansion& e) {
+    for (const std::string& w : e.warnings) emit(canon::Warning{w});
+    const SpindleDir dir_at_start = st.spindle.dir;
+    const double modal_feed = st.feed.feed_mm_s;
+    double announced_feed = modal_feed;
+    auto set_dir = [&](SpindleDir d) {
+        st.spindle.dir = d;
+        emit(canon::Spindle{d});
+    };
+    for (const cycles::Step& step : e.steps) {
+        std::visit(
+            [&](const auto& s) {
+                using T = std::decay_t<decltype(s)>;
+                if constexpr (std::is_same_v<T, cycles::Rapid> || std::is_same_v<T, cycles::Feed>) {
+                    AxisVec p = st.pos.prog_mm;
+                    for (int a = 0; a < 3; ++a) p[a] = s.to_mm[a];
+                    const AxisVec m = to_machine(p);
+                    if constexpr (std::is_same_v<T, cycles::Rapid>) {
+                        emit_rapid(m);
+                    } else {
+                        const double f = s.feed_mm_min / 60.0;
+                        if (f != announced_feed) {
+                            emit(canon::SetFeedRate{f});
+                            announced_feed = f;
+                        }
+                        canon::MoveFlags fl = flags_;
+                        if (s.override_locked) fl.force_full_override = true;
+                        emit(canon::FeedLine{m, fl});
+                        st.pos.machine_mm = m;
+                    }
+                    st.pos.prog_mm = p;
+                } else if constexpr (std::is_same_v<T, cycles::Dwell>) {
+                    emit(canon::Dwell{s.seconds});
+                } else if constexpr (std::is_same_v<T, cycles::SpindleStop>) {
+                    set_dir(SpindleDir::Stop);
+                } else if constexpr (std::is_same_v<T, cycles::SpindleOrient>) {
+                    st.spindle.dir = SpindleDir::Stop;
+                    emit(canon::SpindleOrient{});
+                } else if constexpr (std::is_same_v<T, cycles::SpindleReverse>) {
+                    set_dir(st.spindle.dir == SpindleDir::Cw ? SpindleDir::Ccw : SpindleDir::Cw);
+                } else if constexpr (std::is_same_v<T, cycles::SpindleRestart>) {
+                    set_dir(dir_at_start);
+                } else if constexpr (std::is_same_v<T, cycles::SpindleCw>) {
+                    set_dir(SpindleDir::Cw);
+                } else if constexpr (std::is_same_v<T, cycles::SpindleSpeed>) {
+                    st.spindle.rpm = s.rpm;
+                    emit(canon::SetSpindleSpeed{s.rpm});
+                } else if constexpr (std::is_same_v<T, cycles::OperatorRetract>) {
+                    // G88 manual retract: the program pauses, the operator jogs out and resumes.
+                    emit(canon::Stop{false});
+                }
+            },
+            step);
+    }
+    if (announced_feed != modal_feed) emit(canon::SetFeedRate{modal_feed});
+}
+
+// ---------------------------------------------------------------------------------------------
 // Stops and the end of the program (M30-1, SCL-9, ROT-4, MIR-7, G992-1, TLC-6).
 
 void BlockRun::program_end(bool rewind) {
     xf_mut().clear();
+    st.cycle.cancel();
+    st.cycle_return_to_r = false;
     st.coord.g992_mm = {};
     st.coord.g992_active = false;
     st.motion = MotionModal{};

@@ -630,3 +630,36 @@ TEST(ExecG904Sim, TriggerStopsTheAxisAndBadTriggersAreAlarms) {
 
 }  // namespace
 }  // namespace interp
+
+namespace interp {
+namespace {
+
+TEST(ExecCycles, GroupRulesAndReturnMode) {
+    struct Null : CanonSink {
+        void emit(const Canon&) override {}
+    } sink;
+    Executor exec(sink, BackendConfig{});
+    auto err = [&](const std::string& line) {
+        try {
+            exec.execute(test::blk(line, 3));
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string("ok");
+    };
+    EXPECT_EQ(err("G01 G81 X1 Z-1 R1 F100"), "test.nc:3:5: G01 and G81 cannot share a block");
+    EXPECT_EQ(err("G92 G81 X1 Z-1 R1"), "test.nc:3:5: G92 and G81 both use the axis words");
+    EXPECT_FALSE(exec.cycle_return_to_r());
+    EXPECT_EQ(err("G99"), "ok");
+    EXPECT_TRUE(exec.cycle_return_to_r());
+    EXPECT_EQ(err("G40"), "ok");  // compensation is never on here, so cancelling is a no-op
+    EXPECT_EQ(err("G41 D1"), "test.nc:3:1: unsupported G code G41");
+    // A group-01 code ends the cycle: the next X-only block is a plain move, not a hole.
+    EXPECT_EQ(err("G81 X1 Z-1 R1 F60"), "ok");
+    EXPECT_EQ(err("G00 X2"), "ok");
+    EXPECT_EQ(err("X3"), "ok");
+    EXPECT_DOUBLE_EQ(exec.machine_pos_mm(Axis::Z), 1);  // R level of the G81 hole (G99)
+}
+
+}  // namespace
+}  // namespace interp
