@@ -11,6 +11,7 @@
 // ms for G04 P); the back end applies modal state. MachineQuery answers in mm (degrees for rotary
 // axes) and the front end converts to program units with mm_per_program_unit().
 #include <array>
+#include <bit>
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
@@ -105,14 +106,16 @@ struct Block {
     NcKeywords kw;                   // PLC, LEVEL, FX.., PX.., LX..
 
     // Back to an empty block, cheaper than assigning Block{} (only the used parts are reset).
-    void clear() {
+    // `word_mask` limits which letters are reset (bit i = 'A'+i) when the caller knows which
+    // ones can be set.
+    void clear(std::uint32_t word_mask = (1u << 26) - 1) {
         loc = SourceLoc{};
         n.reset();
         g.clear();
         g_col.clear();
         m.clear();
         m_col.clear();
-        for (auto& w : words) w.reset();
+        for (std::uint32_t m = word_mask; m != 0; m &= m - 1) words[std::countr_zero(m)].reset();
         integer_literal_mask = 0;
         msg.reset();
         kw = NcKeywords{};

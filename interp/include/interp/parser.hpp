@@ -28,6 +28,7 @@ struct ParsedLine {
     int p_name_col = 0;
     bool block_delete = false;  // the line starts with '/'
     bool if_false = false;      // an IF(…) in the line was false: the words after it are dropped
+    std::uint32_t letters_set = 0;  // letters the parser stored in block.words (for reset)
 
     void reset();
 };

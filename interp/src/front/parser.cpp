@@ -9,7 +9,8 @@
 namespace interp {
 
 void ParsedLine::reset() {
-    block.clear();
+    block.clear(letters_set);
+    letters_set = 0;
     is_label = false;
     label_number = -1;
     label_name.clear();
@@ -203,6 +204,7 @@ void BlockParser::parse_letter(Ctx& c, const Token& letter) {
             }
             b.words[i] = v;
             b.word_col[i] = letter.col;
+            c.out.letters_set |= 1u << i;
             if (integer_literal) b.integer_literal_mask |= 1u << i;
             return;
         }
