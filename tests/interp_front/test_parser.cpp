@@ -180,6 +180,8 @@ TEST_F(ParserFixture, ErrorStrayOperator) {
 }
 TEST_F(ParserFixture, ErrorUnknownWord) {
     EXPECT_EQ(error("G1 XY10"), "p.nc:12:4: unknown word 'XY'");
+    // The NcStudio dialect has no GOTO (IF-03).
+    EXPECT_EQ(error("IF(1) GOTO 10"), "p.nc:12:7: unknown word 'GOTO'");
 }
 TEST_F(ParserFixture, ErrorGCodeWithTwoDecimals) {
     EXPECT_EQ(error("G50.15"), "p.nc:12:1: G code G50.150000 has more than one decimal");
