@@ -11,8 +11,9 @@
 // clock-mode: 0 take a record every call (default), 1 on a falling edge of clock, 2 on a
 // rising edge, 3 on either edge; other values behave as 0. A record wanted while the stream
 // is empty counts an underrun and leaves the pins unchanged. enable FALSE pauses everything,
-// clock edge detection included. curr-depth is the number of records waiting; empty is TRUE
-// when there are none. underruns is an I/O pin so that setp can reset it, as in LinuxCNC.
+// clock edge detection included. curr-depth is the number of records waiting at the start of
+// the call; empty is TRUE when there were none. underruns is an I/O pin so that setp can reset it,
+// as in LinuxCNC.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -110,6 +111,11 @@ struct Streamer : hal::Instance {
     }
 
     void update(hal::Period) noexcept {
+        // Like LinuxCNC 2.9, curr-depth and empty describe the stream as this call found it,
+        // before taking a record: the call that takes the last record still shows 1 / FALSE.
+        const std::uint32_t used = stream.used();
+        curr_depth = static_cast<std::int32_t>(used);
+        empty = used == 0;
         if (enable && clocked()) {
             if (stream.pop(record_.data())) {
                 for (std::size_t i = 0; i < pins_.size(); ++i)
@@ -118,9 +124,6 @@ struct Streamer : hal::Instance {
                 underruns = underruns + 1;
             }
         }
-        const std::uint32_t used = stream.used();
-        curr_depth = static_cast<std::int32_t>(used);
-        empty = used == 0;
     }
 
   private:
