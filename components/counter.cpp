@@ -6,8 +6,9 @@
 // and scaling and publishes counts, position and velocity.
 //
 // velocity is the number of phase-A edges since the previous capture, times 1/position-scale,
-// divided by the capture thread's period (LinuxCNC 2.9 has the pin; its estimator is not
-// documented). Index and reset do not disturb it, because it counts edges, not position.
+// divided by the capture thread's period; rawcounts counts every edge and is never reset. Both,
+// like the other outputs, agree cycle by cycle with LinuxCNC 2.9
+// (tests/hal/counter-linuxcnc-xcheck).
 #include <atomic>
 #include <cstdint>
 
@@ -45,7 +46,8 @@ struct Counter : hal::Instance {
             index_enable = false;
         }
         old_z_ = z;
-        rawcounts = raw_.load(std::memory_order_relaxed);
+        // rawcounts counts every edge since loading and is never reset (as LinuxCNC 2.9's).
+        rawcounts = static_cast<std::int32_t>(edges_.load(std::memory_order_relaxed));
     }
 
     void capture_position(hal::Period period) noexcept {
