@@ -153,19 +153,18 @@ TEST_F(ExprFixture, ErrorDivisionByZero) {
     EXPECT_EQ(error("1/(2-2)"), "e.nc:3:2: division by zero");
 }
 TEST_F(ExprFixture, ErrorSqrtNegative) {
-    EXPECT_EQ(error("sqrt(-4)"),
-              "e.nc:3:1: sqrt: square root of a negative number (argument -4.000000)");
+    EXPECT_EQ(error("sqrt(-4)"), "e.nc:3:1: sqrt: square root of a negative number (argument -4)");
 }
 TEST_F(ExprFixture, ErrorLogNotPositive) {
     EXPECT_EQ(error("2+log(0)"),
-              "e.nc:3:3: log: logarithm of a number that is not positive (argument 0.000000)");
+              "e.nc:3:3: log: logarithm of a number that is not positive (argument 0)");
 }
 TEST_F(ExprFixture, ErrorAsinAcosDomain) {
-    EXPECT_EQ(error("asin(2)"), "e.nc:3:1: asin: argument outside [-1, 1] (argument 2.000000)");
-    EXPECT_EQ(error("acos(-1.5)"), "e.nc:3:1: acos: argument outside [-1, 1] (argument -1.500000)");
+    EXPECT_EQ(error("asin(2)"), "e.nc:3:1: asin: argument outside [-1, 1] (argument 2)");
+    EXPECT_EQ(error("acos(-1.5)"), "e.nc:3:1: acos: argument outside [-1, 1] (argument -1.5)");
 }
 TEST_F(ExprFixture, ErrorCtgZero) {
-    EXPECT_EQ(error("ctg(0)"), "e.nc:3:1: ctg: cotangent is undefined (argument 0.000000)");
+    EXPECT_EQ(error("ctg(0)"), "e.nc:3:1: ctg: cotangent is undefined (argument 0)");
 }
 TEST_F(ExprFixture, ErrorExpOverflow) {
     EXPECT_EQ(error("exp(1000)"), "e.nc:3:1: exp gives a value that is not a finite number");
@@ -212,7 +211,7 @@ TEST(ToInteger, RoundsNearAndRejectsFractions) {
         to_integer(2.5, SourceLoc{"f", 1, 2}, "repeat count L");
         FAIL();
     } catch (const Error& e) {
-        EXPECT_STREQ(e.what(), "f:1:2: repeat count L must be an integer, got 2.500000");
+        EXPECT_STREQ(e.what(), "f:1:2: repeat count L must be an integer, got 2.5");
     }
     EXPECT_THROW(to_integer(1e300, {}, "L"), Error);
 }

@@ -118,7 +118,7 @@ TEST_F(FlowFixture, ErrorNameWithoutCall) {
 }
 TEST_F(FlowFixture, ErrorBadRepeatCount) {
     EXPECT_EQ(error("G65 P1 L-1"), "f.nc:4:8: repeat count L must not be negative");
-    EXPECT_EQ(error("G65 P1 L1.5"), "f.nc:4:8: repeat count L must be an integer, got 1.500000");
+    EXPECT_EQ(error("G65 P1 L1.5"), "f.nc:4:8: repeat count L must be an integer, got 1.5");
 }
 TEST_F(FlowFixture, ErrorNegativeProgramNumber) {
     EXPECT_EQ(error("G65 P-1"), "f.nc:4:5: program number P must not be negative");

@@ -136,6 +136,12 @@ TEST(Lexer, OperatorSetsPerDialect) {
     EXPECT_EQ(shape(lex("#1=#2>=1<=2!=3")), "V:1 O:= V:2 O:>= N:1 O:<= N:2 O:!= N:3 E");
 }
 
+TEST(Lexer, TapeMarkerLineIsEmpty) {
+    EXPECT_EQ(shape(lex("%")), "E");
+    EXPECT_EQ(shape(lex("  % ")), "E");
+    EXPECT_EQ(lex_error("G1 %"), "t.nc:7:4: unexpected character '%'");
+}
+
 TEST(Lexer, ColumnsAreOneBased) {
     auto t = lex("  G1  X5");
     EXPECT_EQ(t[0].col, 3);

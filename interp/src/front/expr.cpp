@@ -1,5 +1,7 @@
 #include "interp/expr.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <limits>
 #include <string>
@@ -81,7 +83,7 @@ std::int64_t to_integer(double v, const SourceLoc& loc, std::string_view what) {
         throw Error(loc, std::string(what) + " is out of range");
     }
     if (std::fabs(v - r) > 1e-6) {
-        throw Error(loc, std::string(what) + " must be an integer, got " + std::to_string(v));
+        throw Error(loc, std::string(what) + " must be an integer, got " + fmt::format("{}", v));
     }
     return static_cast<std::int64_t>(r);
 }
@@ -292,8 +294,8 @@ double ExprEvaluator::call_function(const Token& name, TokenCursor& cur) {
     }
     if (dry_) return 0.0;
     auto domain = [&](const char* why) {
-        return Error(loc(name),
-                     std::string(name.text) + ": " + why + " (argument " + std::to_string(x) + ")");
+        return Error(loc(name), std::string(name.text) + ": " + why + " (argument " +
+                                    fmt::format("{}", x) + ")");
     };
     switch (fn->fn) {
         case Fn::Sin:

@@ -197,6 +197,9 @@ void Lexer::lex(std::string_view s, const SourceLoc& loc, std::vector<Token>& ou
             continue;
         }
         if (c == ';') break;
+        // EXT: a '%' line (tape start/end marker in CAM output) carries nothing.
+        if (c == '%' && out.empty() && s.find_first_not_of(" \t%", i) == std::string_view::npos)
+            break;
         // Comment quotes are ' and a UTF-8 sequence starting 0xE2: test the byte first.
         if (d.quote_comments && (c == '\'' || c == '\xE2') &&
             comment_quote_length(s.substr(i)) != 0)

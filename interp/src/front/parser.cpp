@@ -1,5 +1,7 @@
 #include "interp/parser.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <string>
 
@@ -174,7 +176,7 @@ void BlockParser::parse_letter(Ctx& c, const Token& letter) {
             const double scaled = v * 10.0;
             const double r = std::nearbyint(scaled);
             if (std::fabs(scaled - r) > 1e-6) {
-                throw Error(at, "G code G" + std::to_string(v) + " has more than one decimal");
+                throw Error(at, "G code G" + fmt::format("{}", v) + " has more than one decimal");
             }
             if (r < 0 || r > 1e7) throw Error(at, "G code out of range");
             if (!b.g.push_back(static_cast<int>(r)) || !b.g_col.push_back(letter.col)) {
