@@ -69,7 +69,8 @@ void Planner::reset(const AxisArray& start) {
     last_end_ = start;
     have_pending_ = false;
     items_.clear();
-    head_ = 0;
+    groups_.clear();
+    head_ = group_head_ = grouped_end_ = 0;
     v_start_ = 0;
     out_.clear();
     out_head_ = 0;
@@ -175,11 +176,11 @@ void Planner::add_item(const Element& e, double feed, double end_cap, bool rough
     Item it;
     it.geom = e;
     double cut = cfg_.override_reserve + (rough ? cfg_.junction_share : 0);
-    it.share = {1 - cut, 1 - cut};
-    it.lim = element_limits(e, bounds(e), cfg_.limits, feed, it.share);
+    it.lim = element_limits(e, bounds(e), cfg_.limits, feed, {1 - cut, 1 - cut});
     it.end_cap_mm_s = end_cap;
     it.rough = rough;
     it.line = line;
+    it.rapid = feed <= 0;  // blends between two rapids are rapid too
     items_.push_back(it);
 }
 
@@ -201,13 +202,15 @@ bool Planner::can_join(const Group& g, const Item& it) const {
 }
 
 void Planner::build_groups() {
-    groups_.clear();
+    // Groups formed in an earlier round are never changed: the speed where the last emitted
+    // record ended was planned against them, and only appending new groups keeps it reachable.
     // Without a jerk limit every element gets its own trapezoid, which is already time-optimal.
     std::size_t max_items =
         jerk_mode_ ? std::clamp<std::size_t>(cfg_.window / 4, 1, kMaxGroupItems) : 1;
-    for (std::size_t i = head_; i < items_.size(); ++i) {
+    std::size_t first_new = groups_.size();
+    for (std::size_t i = grouped_end_; i < items_.size(); ++i) {
         const Item& it = items_[i];
-        if (!groups_.empty()) {
+        if (groups_.size() > first_new) {
             Group& g = groups_.back();
             if (g.end - g.first < max_items && can_join(g, it)) {
                 g.end = i + 1;
@@ -222,47 +225,76 @@ void Planner::build_groups() {
         groups_.push_back(
             {i, i + 1, it.geom.length_mm, it.lim.vcap_mm_s, it.end_cap_mm_s, it.lim.tangent});
     }
+    grouped_end_ = items_.size();
 }
 
 std::size_t Planner::plan_and_emit(bool all) {
     std::size_t n = items_.size() - head_;
     if (n == 0) return 0;
     build_groups();
-    std::size_t m = groups_.size();
+    const Group* gs = groups_.data() + group_head_;
+    std::size_t m = groups_.size() - group_head_;
     vj_.assign(m + 1, 0.0);
     // Backward pass: the highest speed at each junction from which everything after it, up to
-    // a stop at the window's end, can still be followed.
+    // a stop at the window's end, can still be followed. With a jerk limit the speed reachable
+    // over a length is not monotone in the speed at the other end (a ramp that must start and
+    // end at zero acceleration is slow for small speed changes), so the bound takes the best
+    // end speed in [0, next bound]; the best is at one of the two ends. This keeps the bounds
+    // monotone in the window's end speed, which is what makes streaming safe.
     vj_[m] = 0;
     for (std::size_t i = m - 1; i >= 1; --i) {
-        const Group& a = groups_[i - 1];
-        const Group& g = groups_[i];
-        double bound = std::min({a.vcap_mm_s, g.vcap_mm_s, a.end_cap_mm_s});
-        vj_[i] = std::min(bound, reachable_speed_mm_s(vj_[i + 1], g.length_mm, g.tangent));
+        double bound = std::min({gs[i - 1].vcap_mm_s, gs[i].vcap_mm_s, gs[i - 1].end_cap_mm_s});
+        double back = reachable_speed_mm_s(vj_[i + 1], gs[i].length_mm, gs[i].tangent);
+        if (jerk_mode_)
+            back = std::max(back, reachable_speed_mm_s(0, gs[i].length_mm, gs[i].tangent));
+        vj_[i] = std::min(bound, back);
     }
     // Forward pass: as fast as can be reached from where the last emitted record ended.
     vj_[0] = v_start_;
-    for (std::size_t i = 0; i < m; ++i) {
-        const Group& g = groups_[i];
-        vj_[i + 1] = std::min(vj_[i + 1], reachable_speed_mm_s(vj_[i], g.length_mm, g.tangent));
-    }
+    for (std::size_t i = 0; i < m; ++i) vj_[i + 1] = forward_speed(gs[i], vj_[i], vj_[i + 1]);
     // Emit whole groups, keeping the last half of the window for the next round.
     std::size_t keep = all ? 0 : std::min(n, cfg_.window / 2);
     std::size_t count = 0, emitted = 0;
-    while (count < m && groups_[count].end - head_ <= n - keep) {
-        emit_group(groups_[count], vj_[count], vj_[count + 1]);
-        emitted += groups_[count].end - groups_[count].first;
+    while (count < m && gs[count].end - head_ <= n - keep) {
+        emit_group(gs[count], vj_[count], vj_[count + 1]);
+        emitted += gs[count].end - gs[count].first;
         ++count;
     }
     head_ += emitted;
+    group_head_ += count;
     v_start_ = vj_[count];
+    compact();
+    return emitted;
+}
+
+double Planner::forward_speed(const Group& g, double v, double bound) const {
+    if (v <= bound) return std::min(bound, reachable_speed_mm_s(v, g.length_mm, g.tangent));
+    // Rounding may leave the slow-down to `bound` a hair longer than the group: accept that.
+    double slack = g.length_mm * (1 + 1e-9);
+    if (ramp_distance_mm(v, bound, g.tangent) <= slack || ramp_distance_mm(v, 0, g.tangent) > slack)
+        return bound;
+    // Slowing to `bound` does not fit but a larger slow-down does (jerk-limited ramps, see the
+    // backward pass): the largest end speed below the bound whose ramp fits.
+    double lo = 0, hi = bound;
+    for (int k = 0; k < 60 && hi - lo > 1e-12 * bound; ++k) {
+        double mid = (lo + hi) / 2;
+        (ramp_distance_mm(v, mid, g.tangent) <= g.length_mm ? lo : hi) = mid;
+    }
+    return lo;
+}
+
+void Planner::compact() {
     if (head_ == items_.size()) {
         items_.clear();
-        head_ = 0;
+        groups_.clear();
+        head_ = group_head_ = grouped_end_ = 0;
     } else if (head_ >= cfg_.window) {
         items_.erase(items_.begin(), items_.begin() + static_cast<std::ptrdiff_t>(head_));
-        head_ = 0;
+        groups_.erase(groups_.begin(), groups_.begin() + static_cast<std::ptrdiff_t>(group_head_));
+        for (Group& g : groups_) g.first -= head_, g.end -= head_;
+        grouped_end_ -= head_;
+        head_ = group_head_ = 0;
     }
-    return emitted;
 }
 
 namespace {
@@ -367,6 +399,7 @@ void Planner::emit(const Item& it, const Profile1D& prof) {
                                                     rate_share, cfg_.max_rate);
     }
     rec.line = it.line;
+    rec.rapid = it.rapid;
     rec.seq = seq_++;
 }
 

@@ -63,6 +63,14 @@ void Sampler::set_feed_override(double scale) noexcept {
     override_ = std::clamp(std::isfinite(scale) ? scale : 0.0, 0.0, cfg_.max_rate);
 }
 
+void Sampler::set_rapid_override(double scale) noexcept {
+    rapid_override_ = std::clamp(std::isfinite(scale) ? scale : 0.0, 0.0, cfg_.max_rate);
+}
+
+double Sampler::current_override() const noexcept {
+    return ring_.size() > 0 && ring_.peek(0).rapid ? rapid_override_ : override_;
+}
+
 void Sampler::set_hold(bool on) noexcept {
     hold_ = on;
 }
@@ -80,11 +88,13 @@ void Sampler::clear_abort() noexcept {
 
 double Sampler::rate_target() const noexcept {
     if (abort_ || hold_) return 0;
-    return std::min(override_, rate_cap_ahead());
+    return std::min(current_override(), rate_cap_ahead());
 }
 
 double Sampler::rate_cap_ahead() const noexcept {
-    if (override_ <= 1 && r_ <= 1 && rd_ <= 0) return kInf;  // every plan holds at rate <= 1
+    if (std::max(override_, rapid_override_) <= 1 && r_ <= 1 && rd_ <= 0) {
+        return kInf;  // every plan holds at rate <= 1
+    }
     // Planned time that can pass before the rate could be brought down to 1: phases starting
     // within it must have their caps respected from now on.
     double up = std::max(rd_, 0.0);
@@ -178,7 +188,7 @@ MotionSample Sampler::advance(double dt) noexcept {
         return last_;
     }
     if (ring_.size() == 0) {
-        r_ = abort_ || hold_ ? 0 : std::min(override_, 1.0);
+        r_ = abort_ || hold_ ? 0 : std::min(override_, 1.0);  // the next record starts at rest
         rd_ = rdd_ = 0;
         status_ = {false, false, false, hold_, abort_, r_};
         if (abort_) status_.aborted = true;

@@ -114,6 +114,32 @@ TEST_P(RandomPrograms, AbortStopsWithinLimitsAndStaysStopped) {
     }
 }
 
+// Regression: with a jerk limit the speed reachable over an element is not monotone in the
+// speed at its other end, and a later planning round once lowered a junction bound below what
+// the already emitted speed could slow down to; the record's ramp then ran past its element.
+TEST(RandomProgramsPlanOnly, StreamingWithJerkNeverPlansARampLongerThanItsElement) {
+    for (std::uint64_t seed = 1; seed <= 300; ++seed) {
+        std::mt19937_64 rng(seed * 7 + 1);
+        Program prog = random_program(rng, {60, true});
+        PlannerConfig cfg = config(rng, true, seed % 3 == 0 ? 6 : 50);
+        Planner planner(cfg, prog.start);
+        PreparedSegment rec;
+        auto check = [&] {
+            while (planner.pop(rec)) {
+                double end_s = rec.profile.at(rec.profile.duration_s).s_mm;
+                ASSERT_NEAR(end_s, rec.geom.length_mm, 1e-9 * std::max(1.0, rec.geom.length_mm))
+                    << "seed " << seed << " line " << rec.line;
+            }
+        };
+        for (const PathSegment& s : prog.segs) {
+            planner.push(s);
+            check();
+        }
+        planner.finish();
+        check();
+    }
+}
+
 INSTANTIATE_TEST_SUITE_P(Seeds, RandomPrograms, ::testing::Range<std::uint64_t>(1, 31));
 
 }  // namespace

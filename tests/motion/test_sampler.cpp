@@ -82,6 +82,35 @@ TEST(Sampler, OverrideAboveOneSpeedsUpCruiseButNotPastTheAxisLimit) {
     EXPECT_GT(vfast, 99);
 }
 
+TEST(Sampler, RapidOverrideAppliesToRapidsOnly) {
+    PlannerConfig cfg = uniform(100, 1000, 0);
+    SpscRing<PreparedSegment> ring(16);
+    Sampler sampler(sampler_config(cfg), ring, AxisArray{});
+    Planner p(cfg, {});
+    PathSegment rapid;
+    rapid.end_mm = {100};
+    rapid.rapid = true;
+    p.push(rapid);
+    p.finish();  // stop between the two so each cruises on its own
+    PathSegment feed;
+    feed.end_mm = {200};
+    feed.feed_mm_s = 80;
+    p.push(feed);
+    p.finish();
+    PreparedSegment r;
+    while (p.pop(r)) ring.try_push(r);
+    sampler.set_rapid_override(0.5);
+    sampler.set_feed_override(1.0);
+    double v_rapid = 0, v_feed = 0;
+    for (int i = 0; i < 10000 && !sampler.status().done; ++i) {
+        MotionSample s = sampler.advance(1e-3);
+        (s.pos_mm[0] < 100 ? v_rapid : v_feed) =
+            std::max(s.pos_mm[0] < 100 ? v_rapid : v_feed, s.vel_mm_s[0]);
+    }
+    EXPECT_NEAR(v_rapid, 50, 1e-9);
+    EXPECT_NEAR(v_feed, 80, 1e-9);
+}
+
 TEST(Sampler, HoldStopsSmoothlyThenResumesToTheExactEnd) {
     for (double jerk : {0.0, 1e5}) {
         Rig rig(uniform(100, 1000, jerk), 100, 80);

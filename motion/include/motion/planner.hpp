@@ -74,9 +74,9 @@ class Planner {
     struct Item {
         Element geom;
         ElementLimits lim;
-        LimitShares share;
         double end_cap_mm_s;  // junction speed limit at its end
         bool rough;           // next to a junction that is not smooth
+        bool rapid;
         std::int32_t line;
     };
     // Consecutive elements planned as one profile (jerk-limited mode; otherwise one each).
@@ -99,6 +99,9 @@ class Planner {
     std::size_t plan_and_emit(bool all);  // returns how many records it emitted
     bool can_join(const Group& g, const Item& it) const;
     void build_groups();
+    void compact();
+    // End speed of group g entered at v: as high as reachable, at most `bound`.
+    double forward_speed(const Group& g, double v, double bound) const;
     void emit_group(const Group& g, double v_in, double v_out);
     void emit(const Item& it, const Profile1D& prof);
 
@@ -110,6 +113,8 @@ class Planner {
     std::size_t head_ = 0;
     double v_start_ = 0;
     std::vector<Group> groups_;
+    std::size_t group_head_ = 0;   // first group not yet emitted
+    std::size_t grouped_end_ = 0;  // items before this index belong to a group
     std::vector<double> vj_;
     std::vector<PreparedSegment> out_;
     std::size_t out_head_ = 0;

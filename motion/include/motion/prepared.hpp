@@ -18,6 +18,7 @@ struct PreparedSegment {
     std::array<double, kMaxPhases> phase_rate_cap{};
     std::int32_t line = 0;     // source line tag
     std::uint32_t seq = 0;     // running number, for diagnostics
+    bool rapid = false;        // a traverse (G0): the rapid override applies, not the feed override
     bool program_end = false;  // the last record before the planner was told finish(): ends at rest
 };
 static_assert(std::is_trivially_copyable_v<PreparedSegment>,

@@ -7,7 +7,8 @@
 //     velocity v r,   acceleration a r^2 + v r',   jerk j r^3 + 3 a r r' + v r''.
 // The planner leaves `override_reserve` of each axis's acceleration and jerk unused, and the
 // rate follows its target with |r'| and |r''| small enough that the r', r'' terms fit in that
-// reserve; above r = 1 each record's rate_cap keeps a r^2 and j r^3 within the rest. So any
+// reserve; above r = 1 the per-phase rate caps of the records within reach keep a r^2 and
+// j r^3 within the rest. So any
 // override in [0, max_rate], any hold and any abort keeps every axis within its limits; a hold
 // or abort from full speed takes about 1 / r'max seconds (see rate_limits()).
 //
@@ -52,7 +53,8 @@ class Sampler {
   public:
     Sampler(const SamplerConfig& cfg, SpscRing<PreparedSegment>& ring, const AxisArray& start_mm);
 
-    void set_feed_override(double scale) noexcept;  // clamped to [0, max_rate]
+    void set_feed_override(double scale) noexcept;   // clamped to [0, max_rate]
+    void set_rapid_override(double scale) noexcept;  // for rapid records; clamped likewise
     void set_hold(bool on) noexcept;
     void abort() noexcept;
     // After an abort has stopped: accept records again (the owner resets the planner first).
@@ -65,6 +67,7 @@ class Sampler {
 
   private:
     double rate_target() const noexcept;
+    double current_override() const noexcept;
     double rate_cap_ahead() const noexcept;
     double integrate_rate(double target, double dt) noexcept;
     void consume_finished_records() noexcept;
@@ -78,6 +81,7 @@ class Sampler {
     double rd_ = 0;   // d rate / dt
     double rdd_ = 0;  // d^2 rate / dt^2 in effect
     double override_ = 1;
+    double rapid_override_ = 1;
     bool hold_ = false;
     bool abort_ = false;
     bool jerk_limited_ = false;
