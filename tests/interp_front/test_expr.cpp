@@ -189,6 +189,13 @@ TEST_F(ExprFixture, ErrorOperatorNotInDialect) {
     EXPECT_EQ(error("1==1", ncstudio_v54_dialect()),
               "e.nc:3:2: operator '==' is not available in dialect ncstudio-v54");
 }
+TEST_F(ExprFixture, ErrorNestedTooDeeply) {
+    EXPECT_EQ(error(std::string(300, '(') + "1" + std::string(300, ')')),
+              "e.nc:3:257: expression nested too deeply (more than 256 levels)");
+    EXPECT_EQ(error(std::string(100000, '-') + "1"),
+              "e.nc:3:257: expression nested too deeply (more than 256 levels)");
+    EXPECT_EQ(eval(std::string(200, '(') + "1" + std::string(200, ')')), 1.0);
+}
 TEST_F(ExprFixture, ErrorUnsetVariable) {
     EXPECT_EQ(error("#7+1"), "e.nc:3:1: variable #7 is used before it is set");
 }

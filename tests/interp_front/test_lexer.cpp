@@ -170,6 +170,10 @@ TEST(LexerErrors, HashWithoutName) {
     EXPECT_EQ(lex_error("#=5"), "t.nc:7:1: expected a variable number or parameter name after '#'");
 }
 
+TEST(LexerErrors, NumberOutOfRange) {
+    EXPECT_EQ(lex_error("G1 X" + std::string(400, '9')), "t.nc:7:5: number out of range");
+}
+
 TEST(LexerErrors, SingleBarOutsideV54) {
     EXPECT_EQ(lex_error("#1=|2|"), "t.nc:7:4: unexpected character '|'");
 }

@@ -75,6 +75,29 @@ TEST(Source, MissingFileNamesTheFile) {
     }
 }
 
+TEST(Source, OverlongLineIsAnErrorAndReadingContinues) {
+    const std::string path = temp_path("overlong");
+    {
+        std::ofstream f(path, std::ios::binary);
+        f << "G1 X1\n" << std::string(3 * 1024 * 1024, 'X') << "\nO5\nG1 X3\n";
+    }
+    auto s = Source::open_file(path);
+    EXPECT_TRUE(s->find_label(5));  // indexing steps over the long line
+    std::string_view line;
+    ASSERT_TRUE(s->next_line(line));
+    EXPECT_EQ(line, "G1 X1");
+    try {
+        s->next_line(line);
+        FAIL() << "expected an error";
+    } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()), path + ":2:1: line is longer than 1 MiB");
+    }
+    ASSERT_TRUE(s->next_line(line));
+    EXPECT_EQ(line, "O5");
+    EXPECT_EQ(s->line_number(), 3);
+    ::unlink(path.c_str());
+}
+
 // A file several windows long, with a line longer than the window, read in order and after
 // seeks both inside and outside the current window.
 TEST(Source, StreamsLargeFileAcrossWindowsAndSeeks) {

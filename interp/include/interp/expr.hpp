@@ -76,7 +76,9 @@ class ExprEvaluator {
     MachineQuery& machine_;
     std::string_view file_;
     int line_;
-    int depth_ = 0;  // open parentheses / abs bars
+    static constexpr int kMaxNesting = 256;
+    int depth_ = 0;    // open parentheses / abs bars
+    int nesting_ = 0;  // recursion depth of parse_binary
     bool dry_ = false;
 };
 

@@ -62,6 +62,9 @@ class Source {
     void index_labels();
     void index_line(std::string_view line, SourcePos pos);
     bool fill();
+    // Discards the rest of a line longer than the limit, then throws Error naming it; reading
+    // continues with the next line.
+    [[noreturn]] void skip_overlong_line();
 
     std::string name_;
     std::FILE* file_ = nullptr;        // null for in-memory text

@@ -141,6 +141,7 @@ double ExprEvaluator::read(const Token& var) {
 double ExprEvaluator::evaluate(TokenCursor& cur, bool dry) {
     dry_ = dry;
     depth_ = 0;
+    nesting_ = 0;
     return parse_binary(cur, 1);
 }
 
@@ -168,6 +169,15 @@ double ExprEvaluator::checked(double v, const Token& at, const char* what) const
 }
 
 double ExprEvaluator::parse_binary(TokenCursor& cur, int min_level) {
+    // Bounded recursion: "((((…" or "----…1" must not overflow the stack.
+    if (++nesting_ > kMaxNesting) {
+        throw Error(loc(cur.peek()), "expression nested too deeply (more than " +
+                                         std::to_string(kMaxNesting) + " levels)");
+    }
+    struct Leave {
+        int& n;
+        ~Leave() { --n; }
+    } leave{nesting_};
     double lhs = parse_unary(cur);
     for (;;) {
         const Token& t = cur.peek();

@@ -1,6 +1,8 @@
 #include "interp/lexer.hpp"
 
+#include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -101,8 +103,9 @@ std::size_t scan_number(std::string_view s, std::size_t i, Token& tok) {
         }
         if (t.back() == '.') t.remove_suffix(1);
         double v = 0.0;
-        std::from_chars(t.data(), t.data() + t.size(), v);
-        tok.number = v;
+        const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+        // Out of double range: the caller reports it with the token's column.
+        tok.number = ec == std::errc{} ? v : HUGE_VAL;
     }
     return i;
 }
@@ -181,7 +184,9 @@ std::string describe_byte(char c) {
 void Lexer::lex(std::string_view s, const SourceLoc& loc, std::vector<Token>& out,
                 bool expression_start) const {
     out.clear();
-    out.reserve(s.size() + 1);  // a line never has more tokens than bytes + End
+    // A line never has more tokens than bytes + End; capped so a huge line cannot ask for
+    // gigabytes up front (the vector still grows if it must).
+    out.reserve(std::min<std::size_t>(s.size() + 1, 1024));
     const Dialect& d = *dialect_;
     std::size_t i = 0;
     int depth = 0;
@@ -217,6 +222,7 @@ void Lexer::lex(std::string_view s, const SourceLoc& loc, std::vector<Token>& ou
             i = j;
         } else if (is_digit(c) || (c == '.' && i + 1 < s.size() && is_digit(s[i + 1]))) {
             i = scan_number(s, i, tok);
+            if (!std::isfinite(tok.number)) error(i - tok.text.size(), "number out of range");
         } else if (c == '#') {
             std::size_t j = i + 1;
             if (j < s.size() && is_digit(s[j])) {

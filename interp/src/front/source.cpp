@@ -9,7 +9,9 @@ namespace interp {
 
 namespace {
 constexpr std::size_t kWindowBytes = 64 * 1024;
-}
+// A longer line is certainly not G-code; refusing it keeps memory bounded.
+constexpr std::size_t kMaxLineBytes = 1024 * 1024;
+}  // namespace
 
 std::unique_ptr<Source> Source::open_file(const std::string& path) {
     std::FILE* f = std::fopen(path.c_str(), "rb");
@@ -59,6 +61,7 @@ bool Source::next_line(std::string_view& line) {
         const std::size_t avail = text_.size() - window_pos_;
         const char* nl = static_cast<const char*>(std::memchr(start, '\n', avail));
         if (nl == nullptr && !eof_) {
+            if (avail > kMaxLineBytes) skip_overlong_line();
             fill();
             continue;
         }
@@ -72,6 +75,24 @@ bool Source::next_line(std::string_view& line) {
         ++cur_line_;
         return true;
     }
+}
+
+void Source::skip_overlong_line() {
+    const int line = cur_line_ + 1;
+    for (;;) {
+        window_pos_ = text_.size();
+        fill();
+        if (eof_) break;
+        const char* nl = static_cast<const char*>(std::memchr(text_.data(), '\n', text_.size()));
+        if (nl != nullptr) {
+            window_pos_ = static_cast<std::size_t>(nl - text_.data()) + 1;
+            break;
+        }
+    }
+    cur_line_offset_ = next_offset_;
+    next_offset_ = window_offset_ + window_pos_;
+    cur_line_ = line;
+    throw Error(SourceLoc{name_, line, 1}, "line is longer than 1 MiB");
 }
 
 void Source::seek(const SourcePos& pos) {
@@ -132,7 +153,14 @@ void Source::index_line(std::string_view line, SourcePos pos) {
 
 void Source::index_labels() {
     std::string_view line;
-    while (next_line(line)) index_line(line, line_start());
+    for (;;) {
+        try {
+            if (!next_line(line)) break;
+        } catch (const Error&) {
+            continue;  // an over-long line: reported again when the program reaches it
+        }
+        index_line(line, line_start());
+    }
     seek(SourcePos{});
 }
 
