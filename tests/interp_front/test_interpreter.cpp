@@ -290,7 +290,23 @@ TEST_F(InterpFixture, PublicDatCustomG86WithRetract) {
     // (M901 each), and the M03 inside O203 is the built-in code.
     EXPECT_EQ(ms, (std::vector<int>{901, 901, 3, 30}));
     EXPECT_EQ(interp->variables().fixed_cycle(14, {}), 10.0);
-    EXPECT_EQ(interp->variables().fixed_cycle(11, {}), 0.0);
+    EXPECT_EQ(interp->variables().fixed_cycle(11, {}), 1.0);  // no K: one run
+}
+
+// The same custom G86 under G91 (#FC13=1) takes the O686 branch that calls O786 #FC11 (K) times
+// and leaves G91 active at the end.
+TEST_F(InterpFixture, PublicDatCustomG86UnderG91) {
+    machine.settings["FIXEDCYCLE_BACK"] = 1.0;
+    machine.incremental = true;
+    run("G91 G99 G86 X10 Y10 Z-10 R2 Q3 F300 K2\nM30\n", true);
+    int g91_blocks = 0, xy_moves = 0;
+    for (const Block& b : exec.blocks) {
+        if (b.g.size() == 1 && b.g[0] == 910 && !b.has('Z')) ++g91_blocks;
+        if (b.has('X') && b.get('X') == 10.0 && b.get('Y') == 10.0) ++xy_moves;
+    }
+    EXPECT_EQ(xy_moves, 2);        // O786 ran K2 times
+    EXPECT_EQ(g91_blocks, 1 + 2);  // O686's G91 before the call, O786's final IF(#FC13)G91 twice
+    EXPECT_EQ(interp->variables().fixed_cycle(11, {}), 2.0);
 }
 
 TEST_F(InterpFixture, LibrarySubprogramCallableByG65) {

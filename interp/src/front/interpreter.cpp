@@ -265,6 +265,8 @@ void Interpreter::take_fixed_cycle_args(Block& b) {
             b.words[i].reset();
         }
     }
+    // The repeat count (K, or L as in S0 example 4) defaults to one run.
+    if (!fc_args_[11]) fc_args_[11] = 1.0;
 }
 
 void Interpreter::set_fixed_cycle_vars(const SourceLoc& loc) {
