@@ -220,5 +220,10 @@ TEST(ToInteger, RoundsNearAndRejectsFractions) {
     } catch (const Error& e) {
         EXPECT_STREQ(e.what(), "f:1:2: repeat count L must be an integer, got 2.5");
     }
-    EXPECT_THROW(to_integer(1e300, {}, "L"), Error);
+    try {
+        to_integer(1e300, SourceLoc{"f", 1, 2}, "PLC address");
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_STREQ(e.what(), "f:1:2: PLC address is out of range");
+    }
 }

@@ -127,6 +127,10 @@ TEST_F(FlowFixture, ErrorM98Forms) {
     EXPECT_EQ(error("M98 L2"), "f.nc:4:1: M98 needs P (a program number)");
     EXPECT_EQ(error("M98 P123456789"), "f.nc:4:5: M98 P has more than 8 digits");
 }
+TEST_F(FlowFixture, ErrorM98NegativeWords) {
+    EXPECT_EQ(error("M98 P-3"), "f.nc:4:5: M98 P must not be negative");
+    EXPECT_EQ(error("M98 P3 L-1"), "f.nc:4:5: M98 L (repeat count) must not be negative");
+}
 TEST_F(FlowFixture, ErrorM99NegativeTarget) {
     EXPECT_EQ(error("M99 P-5"), "f.nc:4:5: M99 P must not be negative");
 }

@@ -213,6 +213,11 @@ TEST_F(InterpFixture, ErrorSubprogramNotFound) {
     EXPECT_EQ(exec.lines(), (Lines{1}));  // the failing block did not run its other words
 }
 
+TEST_F(InterpFixture, ErrorCustomGWithCall) {
+    EXPECT_EQ(run_error("G86 G65 P\"helper\"\n", true),
+              "main.nc:1:1: custom G86 and a subprogram call in one block");
+}
+
 TEST_F(InterpFixture, ErrorM17OutsideSubprogram) {
     EXPECT_EQ(run_error("G0 X1\nM17\n"), "main.nc:2:1: M17 outside a subprogram");
 }

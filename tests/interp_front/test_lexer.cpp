@@ -174,6 +174,12 @@ TEST(LexerErrors, NumberOutOfRange) {
     EXPECT_EQ(lex_error("G1 X" + std::string(400, '9')), "t.nc:7:5: number out of range");
 }
 
+TEST(LexerErrors, ParenCommentsDisabledByDialect) {
+    Dialect d = ncstudio_dialect();
+    d.paren_comments = false;
+    EXPECT_EQ(lex_error("G1 X1 (c)", d), "t.nc:7:7: '(' comments are not allowed in this dialect");
+}
+
 TEST(LexerErrors, SingleBarOutsideV54) {
     EXPECT_EQ(lex_error("#1=|2|"), "t.nc:7:4: unexpected character '|'");
 }

@@ -191,6 +191,26 @@ TEST_F(ParserFixture, ErrorNegativeCodes) {
     EXPECT_EQ(error("M-3"), "p.nc:12:1: M code must not be negative");
     EXPECT_EQ(error("M3.5"), "p.nc:12:1: M code must be an integer, got 3.5");
 }
+TEST_F(ParserFixture, ErrorNegativeSequenceNumber) {
+    EXPECT_EQ(error("N-1 G1"), "p.nc:12:1: sequence number N must not be negative");
+}
+TEST_F(ParserFixture, ErrorTooManyMCodes) {
+    EXPECT_EQ(error("M1 M1 M1 M1 M1 M1 M1 M1 M1 M1 M1 M1 M1 M1 M1 M1 M1"),
+              "p.nc:12:49: too many M codes in one block");
+}
+TEST_F(ParserFixture, ErrorProgramNameAndNumber) {
+    EXPECT_EQ(error("G65 P\"a\" P2"), "p.nc:12:10: word P appears twice in one block");
+    EXPECT_EQ(error("G65 P2 P\"a\""), "p.nc:12:8: word P appears twice in one block");
+}
+TEST_F(ParserFixture, ErrorAssignToOutOfRangeVariable) {
+    EXPECT_EQ(error("#0=1"), "p.nc:12:1: variable #0 is out of range (#1…#999)");
+}
+TEST_F(ParserFixture, ErrorStrictSpaceAfterEquals) {
+    Dialect strict = ncstudio_dialect();
+    strict.tolerant_expr_spaces = false;
+    EXPECT_EQ(error("X= 5", strict), "p.nc:12:4: spaces are not allowed inside an expression");
+    EXPECT_EQ(error("X= 5"), "no error");
+}
 TEST_F(ParserFixture, ErrorTwoSequenceNumbers) {
     EXPECT_EQ(error("N1 N2"), "p.nc:12:4: a block can have only one sequence number N");
 }
