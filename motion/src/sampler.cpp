@@ -53,7 +53,7 @@ RateLimits rate_limits(const SamplerConfig& cfg) noexcept {
 }
 
 Sampler::Sampler(const SamplerConfig& cfg, SpscRing<PreparedSegment>& ring, const AxisArray& start)
-    : cfg_(cfg), rl_(rate_limits(cfg)), ring_(ring) {
+    : cfg_(cfg), rl_(rate_limits(cfg)), last_limits_(rl_), ring_(ring) {
     last_.pos_mm = start;
     jerk_limited_ = std::any_of(cfg.limits.jerk_mm_s3.begin(), cfg.limits.jerk_mm_s3.end(),
                                 [](double j) { return j > 0; });
@@ -122,8 +122,8 @@ double Sampler::rate_cap_ahead() const noexcept {
 
 // Moves (r, r') towards (target, 0) for dt along the time-optimal path with |r'| and |r''|
 // bounded, integrating exactly over its constant-r'' pieces; returns the planned time passed.
-double Sampler::integrate_rate(double target, double dt) noexcept {
-    const double vm = rl_.max_rate_per_s, am = rl_.max_rate_per_s2;
+double Sampler::integrate_rate(double target, double dt, const RateLimits& lim) noexcept {
+    const double vm = lim.max_rate_per_s, am = lim.max_rate_per_s2;
     double passed = 0, left = dt;
     for (int iter = 0; iter < 4 && left > 0; ++iter) {
         double d = target - r_;
@@ -166,6 +166,32 @@ double Sampler::integrate_rate(double target, double dt) noexcept {
     return std::max(passed, 0.0);
 }
 
+RateLimits Sampler::rate_limits_now(double target, double dt) const noexcept {
+    // Slowing down from a rate <= 1 (hold, abort, override down): as r falls, a r^2 and j r^3
+    // leave more of each axis's limits to the r' and r'' terms, and the planned axis speed
+    // (bounded over the time it takes to change r') bounds v r' better than vmax does. Both
+    // fixed reserve limits and these stay valid, so the larger of each is used.
+    if (!(target < r_ && rd_ <= 0 && r_ <= 1)) return rl_;
+    const AxisLimits& lim = cfg_.limits;
+    const double keep = 1 - cfg_.override_reserve;
+    MotionSample now = sample(ring_.peek(0), tau_);
+    double horizon = dt + last_limits_.max_rate_per_s / last_limits_.max_rate_per_s2;
+    double vm = kInf, am = kInf;
+    for (int k = 0; k < kAxes; ++k) {
+        double vk = std::fabs(now.vel_mm_s[k]) + lim.acc_mm_s2[k] * r_ * horizon;
+        if (vk <= 0) continue;
+        vm = std::min(vm, lim.acc_mm_s2[k] * (1 - keep * r_ * r_) / vk);
+        if (lim.jerk_mm_s3[k] > 0) {
+            double free_jerk = lim.jerk_mm_s3[k] * (1 - keep * r_ * r_ * r_);
+            if (r_ > 0) vm = std::min(vm, free_jerk / (2 * 3 * keep * lim.acc_mm_s2[k] * r_));
+            am = std::min(am, free_jerk / (2 * vk));
+        }
+    }
+    if (!std::isfinite(vm)) return rl_;
+    if (!jerk_limited_) am = vm / 0.005;
+    return {std::max(vm, rl_.max_rate_per_s), std::max(am, rl_.max_rate_per_s2)};
+}
+
 void Sampler::consume_finished_records() noexcept {
     while (ring_.size() > 0) {
         const PreparedSegment& cur = ring_.peek(0);
@@ -204,7 +230,8 @@ MotionSample Sampler::advance(double dt) noexcept {
         r_ = target;
         rd_ = rdd_ = 0;
     }
-    tau_ += integrate_rate(target, dt);
+    last_limits_ = rate_limits_now(target, dt);
+    tau_ += integrate_rate(target, dt, last_limits_);
     consume_finished_records();
     const PreparedSegment& cur = ring_.peek(0);
     MotionSample planned = sample(cur, tau_);

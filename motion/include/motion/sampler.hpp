@@ -9,8 +9,9 @@
 // rate follows its target with |r'| and |r''| small enough that the r', r'' terms fit in that
 // reserve; above r = 1 the per-phase rate caps of the records within reach keep a r^2 and
 // j r^3 within the rest. So any
-// override in [0, max_rate], any hold and any abort keeps every axis within its limits; a hold
-// or abort from full speed takes about 1 / r'max seconds (see rate_limits()).
+// override in [0, max_rate], any hold and any abort keeps every axis within its limits. While
+// slowing down the bounds on r' and r'' grow as a r^2 and j r^3 shrink (rate_limits_now()), so a
+// hold from full speed takes a few tenths of a second rather than 1 / r'max.
 //
 // Everything on this class is realtime-safe (noexcept, no allocation, bounded time) except
 // the constructor. One thread drives advance(); the controls may be called from the same thread.
@@ -69,11 +70,13 @@ class Sampler {
     double rate_target() const noexcept;
     double current_override() const noexcept;
     double rate_cap_ahead() const noexcept;
-    double integrate_rate(double target, double dt) noexcept;
+    double integrate_rate(double target, double dt, const RateLimits& lim) noexcept;
+    RateLimits rate_limits_now(double target, double dt) const noexcept;
     void consume_finished_records() noexcept;
 
     SamplerConfig cfg_;
-    RateLimits rl_;
+    RateLimits rl_;           // fixed limits from the reserve
+    RateLimits last_limits_;  // limits used in the last period
     SpscRing<PreparedSegment>& ring_;
     MotionSample last_{};
     double tau_ = 0;  // planned time within the front record
