@@ -61,4 +61,5 @@ struct Debounce : hal::Instance {
 
 }  // namespace
 
-HAL_COMPONENT(debounce, Debounce, "filter noisy digital inputs", "cfg")
+HAL_COMPONENT_WITH_OPTIONS(debounce, Debounce, "filter noisy digital inputs",
+                           (hal::ComponentOptions{.count_from = "cfg"}), "cfg")

@@ -269,4 +269,5 @@ struct Encoder : hal::Instance {
 
 }  // namespace
 
-HAL_COMPONENT(encoder, Encoder, "software counting of quadrature encoder signals")
+HAL_COMPONENT_WITH_OPTIONS(encoder, Encoder, "software counting of quadrature encoder signals",
+                           (hal::ComponentOptions{.default_count = 3}))

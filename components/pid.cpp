@@ -368,4 +368,5 @@ struct Pid : hal::Instance {
 
 }  // namespace
 
-HAL_COMPONENT(pid, Pid, "proportional/integral/derivative controller with auto tuning", "debug")
+HAL_COMPONENT_WITH_OPTIONS(pid, Pid, "proportional/integral/derivative controller with auto tuning",
+                           (hal::ComponentOptions{.default_count = 3}), "debug")

@@ -105,4 +105,5 @@ struct Sampler : hal::Instance {
 
 }  // namespace
 
-HAL_COMPONENT(sampler, Sampler, "sample data from HAL in real time", "cfg", "depth")
+HAL_COMPONENT_WITH_OPTIONS(sampler, Sampler, "sample data from HAL in real time",
+                           (hal::ComponentOptions{.count_from = "cfg"}), "cfg", "depth")

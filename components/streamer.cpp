@@ -149,4 +149,5 @@ struct Streamer : hal::Instance {
 
 }  // namespace
 
-HAL_COMPONENT(streamer, Streamer, "stream file data into HAL in real time", "cfg", "depth")
+HAL_COMPONENT_WITH_OPTIONS(streamer, Streamer, "stream file data into HAL in real time",
+                           (hal::ComponentOptions{.count_from = "cfg"}), "cfg", "depth")

@@ -35,7 +35,7 @@ struct WeightedSum : hal::Instance {
     WeightedSum() {
         for (std::size_t m = 0; m < weight.size(); ++m)
             weight[m] = static_cast<std::int32_t>(std::uint32_t{1} << m);
-        shared_function<&WeightedSum::process>("process_wsums");
+        shared_function<&WeightedSum::process>("=process_wsums");
     }
 
     void process(hal::Period) noexcept {
@@ -50,4 +50,5 @@ struct WeightedSum : hal::Instance {
 
 }  // namespace
 
-HAL_COMPONENT(weighted_sum, WeightedSum, "Convert a group of bits to an integer", "wsum_sizes")
+HAL_COMPONENT_WITH_OPTIONS(weighted_sum, WeightedSum, "Convert a group of bits to an integer",
+                           (hal::ComponentOptions{.prefix = "wsum", .count_from = "wsum_sizes"}), "wsum_sizes")

@@ -182,7 +182,8 @@ void register_shared_function(Instance& owner, std::string_view name, RealtimeFn
     auto& ctx = context_of(owner, "function");
     Runtime& rt = *ctx.runtime;
     Component& comp = *ctx.component;
-    auto full = fmt::format("{}.{}", comp.name, name);
+    auto full = !name.empty() && name[0] == '=' ? std::string(name.substr(1))
+                                                : fmt::format("{}.{}", comp.name, name);
     auto it = rt.functs_.find(full);
     if (it != rt.functs_.end()) {
         if (it->second->component != &comp || it->second->fn != &SharedFunct::call_all)
@@ -667,8 +668,14 @@ void Runtime::load_component(const std::string& name, const std::vector<std::str
     }
     int first_index = existing ? static_cast<int>(existing->instances.size()) : 0;
     if (names.empty()) {
-        long n = count < 0 ? 1 : count;
-        for (long i = 0; i < n; ++i) names.push_back(fmt::format("{}.{}", comp->name, first_index + i));
+        const auto& opts = comp->descriptor->options;
+        long n = count < 0 ? opts.default_count : count;
+        if (count < 0 && opts.count_from)
+            if (auto it = kv.find(opts.count_from); it != kv.end())
+                n = static_cast<long>(std::count(it->second.begin(), it->second.end(), ',')) + 1;
+        std::string prefix = opts.prefix ? opts.prefix : comp->name;
+        if (!opts.prefix) std::replace(prefix.begin(), prefix.end(), '_', '-');
+        for (long i = 0; i < n; ++i) names.push_back(fmt::format("{}.{}", prefix, first_index + i));
     }
     std::set<std::string> seen;
     for (auto& n : names) {

@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <thread>
 
@@ -214,8 +215,13 @@ void Script::cmd_loadusr(const std::vector<std::string>& words) {
     }
     if (i >= words.size()) throw Error("usage: loadusr [-W|-w|-i|-Wn NAME] PROGRAM [ARGS...]");
     std::vector<std::string> argv(words.begin() + static_cast<long>(i), words.end());
-    if (name.empty()) {
-        name = argv[0].substr(argv[0].rfind('/') + 1);
+    if (name.empty()) name = argv[0].substr(argv[0].rfind('/') + 1);
+    // Our own tools (halsampler, halstreamer, …) come before same-named programs on PATH,
+    // e.g. LinuxCNC's, which would attach to the wrong bus.
+    if (argv[0].find('/') == std::string::npos) {
+        std::error_code ec;
+        auto own = std::filesystem::read_symlink("/proc/self/exe", ec).parent_path() / argv[0];
+        if (!ec && ::access(own.c_str(), X_OK) == 0) argv[0] = own.string();
     }
     std::fflush(stdout);
     std::fflush(stderr);

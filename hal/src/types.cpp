@@ -75,8 +75,10 @@ std::optional<Value> parse_value(Type t, std::string_view text) noexcept {
             std::string s(text);
             if (s.empty()) return std::nullopt;
             char* end = nullptr;
+            // nan and inf are accepted as LinuxCNC does: a user may need to inject one to
+            // test a component's guard; strtod takes both spellings.
             v.f = std::strtod(s.c_str(), &end);
-            if (*end || !std::isfinite(v.f)) return std::nullopt;
+            if (*end) return std::nullopt;
             return v;
         }
         case Type::S32:

@@ -25,11 +25,11 @@ TEST_F(ClientTest, UserspaceComponentPinsJoinTheBus) {
         auto seen = user.new_pin("ui.seen", Type::Float, Dir::In);
         user.ready();
         EXPECT_TRUE(rt->component_ready("ui"));
-        run("loadrt t_probe");
+        run("loadrt tprobe");
         run("loadrt threads name1=t period1=1000000");
-        run("addf t_probe.0 t");
-        run("net jog ui.jog t_probe.0.in-float");
-        run("net back t_probe.0.out-float ui.seen");
+        run("addf tprobe.0 t");
+        run("net jog ui.jog tprobe.0.in-float");
+        run("net back tprobe.0.out-float ui.seen");
         Value v;
         v.f = 2.5;
         jog.set(v);
@@ -37,7 +37,7 @@ TEST_F(ClientTest, UserspaceComponentPinsJoinTheBus) {
         run("advance 0.001");
         EXPECT_EQ(seen.get().f, 5.0);  // gain 2: written by the RT function, read lock-free here
         EXPECT_NE(run("show comp ui").find(fmt::format("User  ui {:>37}  ready", ::getpid())), std::string::npos);
-        auto found = user.find("t_probe.0.gain");
+        auto found = user.find("tprobe.0.gain");
         EXPECT_EQ(found.get().f, 2.0);
     }
     // Closing the client removes its component and pins; signals stay.
@@ -50,14 +50,14 @@ TEST_F(ClientTest, RemoteCommandsReturnOutputAndErrors) {
     Connection c(rt->paths().instance);
     RemoteBackend remote(c);
     std::string out;
-    remote.exec({"loadrt", "t_probe"}, out);
-    remote.exec({"getp", "t_probe.0.in-float"}, out);
+    remote.exec({"loadrt", "tprobe"}, out);
+    remote.exec({"getp", "tprobe.0.in-float"}, out);
     EXPECT_EQ(out, "1.5\n");
     try {
-        remote.exec({"getp", "t_probe.0.nope"}, out);
+        remote.exec({"getp", "tprobe.0.nope"}, out);
         FAIL();
     } catch (const Error& e) {
-        EXPECT_EQ(std::string(e.what()), "pin or parameter 't_probe.0.nope' does not exist");
+        EXPECT_EQ(std::string(e.what()), "pin or parameter 'tprobe.0.nope' does not exist");
     }
     auto pins = remote.names("pin");
     EXPECT_EQ(pins.size(), 12u);  // 6 inputs, 2 outputs, io, cycles, 2 taps
@@ -65,13 +65,13 @@ TEST_F(ClientTest, RemoteCommandsReturnOutputAndErrors) {
 
 TEST_F(ClientTest, StreamRecordsCrossProcessesInOrder) {
     run("loadrt threads name1=t period1=1000000");
-    run("loadrt t_stream");
-    run("addf t_stream.0 t");
-    run("setp t_stream.0.value 1.25");
+    run("loadrt tstream");
+    run("addf tstream.0 t");
+    run("setp tstream.0.value 1.25");
     run("start");
     run("advance 0.010");  // 10 cycles into a ring of 8: two pushes refused
     Client reader("", rt->paths().instance);
-    auto s = reader.stream("t_stream.0");
+    auto s = reader.stream("tstream.0");
     EXPECT_EQ(s.fields(), 2u);
     EXPECT_EQ(s.field_type(1), Type::Bit);
     EXPECT_EQ(s.used(), 8u);
@@ -83,7 +83,7 @@ TEST_F(ClientTest, StreamRecordsCrossProcessesInOrder) {
         EXPECT_EQ(rec[1].b, i % 2 == 0);
     }
     EXPECT_FALSE(s.pop(rec));
-    EXPECT_THROW(reader.stream("t_stream.1"), Error);
+    EXPECT_THROW(reader.stream("tstream.1"), Error);
 }
 
 TEST(Connection, NoInstanceIsAClearError) {

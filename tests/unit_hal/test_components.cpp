@@ -75,17 +75,17 @@ struct Streamer : hal::Instance {
 }  // namespace
 
 #if defined(TEST_COMPONENT_PROBE)
-HAL_COMPONENT(t_probe, Probe, "runtime test: every pin type", "taps")
+HAL_COMPONENT(tprobe, Probe, "runtime test: every pin type", "taps")
 #elif defined(TEST_COMPONENT_FAILING)
-HAL_COMPONENT(t_failing, Failing, "runtime test: constructor failure", "fail-at")
+HAL_COMPONENT(tfailing, Failing, "runtime test: constructor failure", "fail-at")
 #elif defined(TEST_COMPONENT_SPINNER)
-HAL_COMPONENT(t_spinner, Spinner, "runtime test: late cycles")
+HAL_COMPONENT(tspinner, Spinner, "runtime test: late cycles")
 #elif defined(TEST_COMPONENT_STREAM)
-HAL_COMPONENT(t_stream, Streamer, "runtime test: stream producer")
+HAL_COMPONENT(tstream, Streamer, "runtime test: stream producer")
 #elif defined(TEST_COMPONENT_BADABI)
 extern "C" __attribute__((visibility("default"))) const hal::ComponentDescriptor* cnc_hal_component() {
     static const char* const args[] = {nullptr};
-    static const hal::ComponentDescriptor d{hal::kAbiVersion + 100, "t_badabi", "wrong ABI", args,
+    static const hal::ComponentDescriptor d{hal::kAbiVersion + 100, "tbadabi", "wrong ABI", args,
                                             &hal::detail::create_instance<Probe>};
     return &d;
 }

@@ -15,16 +15,16 @@ std::uint64_t as_u64(const std::string& s) { return std::stoull(s); }
 TEST_F(ThreadRt, ALateCycleIsCountedNotReplayed) {
     make(false, "late");
     run("loadrt threads name1=t period1=1000000");
-    run("loadrt t_spinner");
-    run("addf t_spinner.0 t");
+    run("loadrt tspinner");
+    run("addf tspinner.0 t");
     run("start");
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
     // One call that takes 20 periods: the thread must skip the missed deadlines.
-    auto calls_before = as_u64(run("getp t_spinner.0.calls"));
+    auto calls_before = as_u64(run("getp tspinner.0.calls"));
     auto t0 = std::chrono::steady_clock::now();
-    run("setp t_spinner.0.spin-ns 20000000");
+    run("setp tspinner.0.spin-ns 20000000");
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
-    auto calls_after = as_u64(run("getp t_spinner.0.calls"));
+    auto calls_after = as_u64(run("getp tspinner.0.calls"));
     double elapsed_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     run("stop");
     EXPECT_GE(as_u64(run("getp t.late-cycles")), 19u);
@@ -36,8 +36,8 @@ TEST_F(ThreadRt, ALateCycleIsCountedNotReplayed) {
 TEST_F(ThreadRt, ThreadsPublishTimingInNanoseconds) {
     make(false, "timing");
     run("loadrt threads name1=t period1=500000");
-    run("loadrt t_probe");
-    run("addf t_probe.0 t");
+    run("loadrt tprobe");
+    run("addf tprobe.0 t");
     run("setp t.funct-sample 1");
     auto t0 = std::chrono::steady_clock::now();
     run("start");
@@ -47,10 +47,10 @@ TEST_F(ThreadRt, ThreadsPublishTimingInNanoseconds) {
     auto cycles = as_u64(run("getp t.cycles"));
     EXPECT_GE(cycles, 100u);  // 200 expected; a loaded CI machine may lose some
     EXPECT_LE(static_cast<double>(cycles), elapsed_ms * 2 + 1);  // never more than the deadlines passed
-    EXPECT_GT(std::stoll(run("getp t_probe.0.tmax")), 0);
-    EXPECT_LT(std::stoll(run("getp t_probe.0.tmax")), 50'000'000);
+    EXPECT_GT(std::stoll(run("getp tprobe.0.tmax")), 0);
+    EXPECT_LT(std::stoll(run("getp tprobe.0.tmax")), 50'000'000);
     auto show = run("show thread");
-    EXPECT_NE(show.find("1 t_probe.0"), std::string::npos);
+    EXPECT_NE(show.find("1 tprobe.0"), std::string::npos);
 }
 
 TEST(Histogram, BucketsAreOrderedAndTight) {

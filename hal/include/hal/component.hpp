@@ -123,6 +123,7 @@ protected:
     }
     // One function for all instances of the component ("encoder.update-counters"), as
     // LinuxCNC's hand-written drivers export: it calls Method on every instance in order.
+    // A name starting with '=' is used as it is ("=process_wsums"), without the prefix.
     template <auto Method>
     void shared_function(std::string_view name, bool uses_fp = true) {
         using C = typename detail::MemberOf<decltype(Method)>::type;
@@ -293,23 +294,42 @@ Instance* detail::create_instance() {
     return inst.release();
 }
 
+// Naming rules a few LinuxCNC components need; the defaults suit almost all.
+struct ComponentOptions {
+    // Prefix of default instance names ("wsum" -> wsum.0); null: the component name with
+    // '_' turned into '-' (conv_float_s32 -> conv-float-s32.0), as LinuxCNC's comp does.
+    const char* prefix = nullptr;
+    // A loadrt argument whose comma-list length is the default instance count
+    // (weighted_sum's wsum_sizes=8,4 makes two summers).
+    const char* count_from = nullptr;
+    // Instances made when neither count=, names= nor count_from says (pid and encoder: 3).
+    int default_count = 1;
+};
+
 struct ComponentDescriptor {
-    std::uint32_t abi_version;
+    std::uint32_t abi_version;  // first, and kept first by every future version
     const char* name;
     const char* doc;
     // loadrt arguments accepted besides count=, names= and num_chan=; null-terminated.
     const char* const* args;
     Instance* (*create)();
+    ComponentOptions options;
 };
 
 }  // namespace hal
 
 // The one entry point of a component .so. Extra arguments name the loadrt keys it accepts.
-#define HAL_COMPONENT(NAME, TYPE, DOC, ...)                                                    \
+#define HAL_COMPONENT(NAME, TYPE, DOC, ...) \
+    HAL_COMPONENT_WITH_OPTIONS(NAME, TYPE, DOC, (::hal::ComponentOptions{}) __VA_OPT__(, ) __VA_ARGS__)
+
+// The same with naming options: HAL_COMPONENT_WITH_OPTIONS(weighted_sum, WeightedSum, "doc",
+// (hal::ComponentOptions{.prefix = "wsum", .count_from = "wsum_sizes"}), "wsum_sizes")
+#define HAL_COMPONENT_WITH_OPTIONS(NAME, TYPE, DOC, OPTIONS, ...)                              \
     extern "C" __attribute__((visibility("default"))) const ::hal::ComponentDescriptor*     \
     cnc_hal_component() {                                                                    \
         static const char* const args[] = {__VA_ARGS__ __VA_OPT__(, ) nullptr};              \
         static const ::hal::ComponentDescriptor descriptor{                                 \
-            ::hal::kAbiVersion, #NAME, DOC, args, &::hal::detail::create_instance<TYPE>};    \
+            ::hal::kAbiVersion, #NAME, DOC, args, &::hal::detail::create_instance<TYPE>,     \
+            OPTIONS};                                                                        \
         return &descriptor;                                                                  \
     }
