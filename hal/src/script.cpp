@@ -147,12 +147,15 @@ void Script::run_words(const std::vector<std::string>& words, std::string& out) 
     }
 }
 
+void Script::execute(const std::string& text, std::string& out) {
+    auto words = tokenize(text);
+    if (!words.empty()) run_words(words, out);
+}
+
 bool Script::run_line(const std::string& text, const std::string& where, int line) {
     std::string out;
     try {
-        auto words = tokenize(text);
-        if (words.empty()) return true;
-        run_words(words, out);
+        execute(text, out);
         fmt::print("{}", out);
         std::fflush(stdout);
         return true;

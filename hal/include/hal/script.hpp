@@ -36,6 +36,8 @@ public:
     bool run_file(const std::string& path);
     // Runs one logical line (interactive use); prints output, returns false on error.
     bool run_line(const std::string& text, const std::string& where = "<stdin>", int line = 0);
+    // Runs one logical line, appending its output; throws hal::Error. Prints nothing.
+    void execute(const std::string& text, std::string& out);
     // Splits a line into words, after substitution. Throws hal::Error.
     std::vector<std::string> tokenize(const std::string& line) const;
     // Process ids of loadusr children still running (halrun ends them on exit).
