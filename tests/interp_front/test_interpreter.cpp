@@ -314,6 +314,17 @@ TEST_F(InterpFixture, PublicDatCustomG86UnderG91) {
     EXPECT_EQ(interp->variables().fixed_cycle(11, {}), 2.0);
 }
 
+// Two custom codes in one block run one after the other; a code only queued behind the running
+// one is not "inside" it, so M05 within O203 still runs O205.
+TEST_F(InterpFixture, QueuedCustomCodeIsNotActiveYet) {
+    interp = std::make_unique<Interpreter>(exec, machine, options);
+    interp->set_library(Source::from_string("lib.dat", "O203\nM05\nM17\nO205\nG1 X5\nM17\n"));
+    interp->open(Source::from_string("main.nc", "M03 M05\nM30\n"));
+    interp->run();
+    EXPECT_EQ(exec.values('X'), (Values{5, 5}));
+    EXPECT_EQ(exec.lines(), (Lines{5, 5, 2}));
+}
+
 TEST_F(InterpFixture, LibrarySubprogramCallableByG65) {
     run("G65 P\"helper\"\nM30\n", true);
     EXPECT_EQ(exec.values('X'), (Values{77}));

@@ -214,8 +214,9 @@ std::optional<CallFrame> Interpreter::resolve_call(const CallRequest& c) {
 }
 
 bool Interpreter::custom_code_active(int code) const {
+    // Only runs that have started: a code queued behind the running one is not "inside" it.
     for (const CallFrame& f : stack_)
-        if (f.custom_code == code) return true;
+        if (f.started && f.custom_code == code) return true;
     return false;
 }
 
