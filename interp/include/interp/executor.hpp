@@ -14,6 +14,7 @@
 
 #include "interp/block.hpp"
 #include "interp/canon.hpp"
+#include "interp/crc_stage.hpp"
 #include "interp/cycles.hpp"
 #include "interp/modal.hpp"
 #include "interp/persist.hpp"
@@ -43,6 +44,7 @@ struct BackendConfig {
     // Machine settings readable as named parameters (SAFEHEIGHT, MOBICALI_THICKNESS, …), mm.
     std::map<std::string, double, std::less<>> machine_settings;
     cycles::CycleConfig cycles;  // canned-cycle machine parameters (FIXEDCYCLE_BACK, …)
+    cutter::Config cutter;       // cutter radius compensation look-ahead and corner rules
 };
 
 // Everything the executor keeps between blocks apart from settings and transforms.
@@ -58,6 +60,9 @@ struct ExecState {
     IoState io;
     cycles::CycleState cycle;      // active canned cycle and its modal data (G80 = none)
     bool cycle_return_to_r = false;  // G99 (else G98)
+    cutter::Side crc_side = cutter::Side::Off;  // G40/G41/G42 as programmed
+    std::optional<int> crc_d;                    // last D word (selects the radius)
+    CrcBlockState crc;  // what the compensator gets for this block (mirroring swaps the side)
     bool started = false;  // the initial offsets have been announced
 };
 
@@ -101,6 +106,7 @@ private:
     ExecState state_;
     ProgramTransform xf_;
     std::vector<Canon> out_;  // the current block's commands, reused to avoid allocation
+    CrcStage crc_;
     std::function<void(const Settings&)> settings_listener_;
 };
 

@@ -32,6 +32,7 @@ enum class GGroup {
     FeedMode,
     Cycle,       // G73 … G89, G80
     CycleReturn, // G98 / G99
+    Crc,         // G40 / G41 / G42
     Flag,
 };
 
@@ -71,7 +72,8 @@ constexpr GInfo kGTable[] = {
     {gcode(89), GGroup::Cycle, false},     {gcode(98), GGroup::CycleReturn, false},
     {gcode(99), GGroup::CycleReturn, false}, {gcode(34), GGroup::NonModal, true},
     {gcode(35), GGroup::NonModal, true},   {gcode(36), GGroup::NonModal, true},
-    {gcode(37), GGroup::NonModal, true},   {gcode(40), GGroup::Flag, false},
+    {gcode(37), GGroup::NonModal, true},   {gcode(40), GGroup::Crc, false},
+    {gcode(41), GGroup::Crc, false},       {gcode(42), GGroup::Crc, false},
     {gcode(918), GGroup::NonModal, false}, {gcode(919), GGroup::NonModal, false},
     {gcode(921), GGroup::NonModal, true},  {gcode(922), GGroup::NonModal, true},
     {gcode(923), GGroup::NonModal, true},  {gcode(992), GGroup::NonModal, true},
@@ -154,6 +156,8 @@ private:
     void step_plane();
     void announce_units();
     void step_tool_length();
+    void step_cutter_comp();
+    void step_crc_effective();
     void step_wcs();
     void step_distance();
     void step_transforms();
@@ -260,11 +264,11 @@ const BlockRun::Step BlockRun::kSteps[] = {
     &BlockRun::step_feed,      &BlockRun::step_spindle_speed, &BlockRun::step_tool,
     &BlockRun::step_spindle,   &BlockRun::step_coolant,       &BlockRun::step_io,
     &BlockRun::step_dwell,     &BlockRun::step_plane,         &BlockRun::announce_units,
-    &BlockRun::step_tool_length,
+    &BlockRun::step_cutter_comp,   &BlockRun::step_tool_length,
     &BlockRun::step_wcs,       &BlockRun::step_distance,      &BlockRun::step_transforms,
     &BlockRun::step_settings_writes, &BlockRun::step_machine_codes, &BlockRun::step_cycle_modes,
     &BlockRun::step_motion,
-    &BlockRun::step_stop,
+    &BlockRun::step_stop,          &BlockRun::step_crc_effective,
 };
 
 void BlockRun::run() {
@@ -300,9 +304,6 @@ void BlockRun::validate() {
             axis_user_ = info;
         }
     }
-    if (axis_user_ && motion_code_)
-        fail(loc_g(*motion_code_), fmt::format("{} and {} both use the axis words",
-                                               gname(axis_user_->code), gname(*motion_code_)));
     if (motion_code_ && cycle_code_ && *cycle_code_ != gcode(80))
         fail(loc_g(*cycle_code_), fmt::format("{} and {} cannot share a block",
                                               gname(*motion_code_), gname(*cycle_code_)));
@@ -595,6 +596,39 @@ void BlockRun::step_tool_length() {
     if (before == st.tool.offset_mm) emit(canon::ToolOffset{st.tool.offset_mm});
 }
 
+// G40/G41/G42 and D (CRC-1, CRC-7, EX-35: D alone only selects the radius).
+void BlockRun::step_cutter_comp() {
+    if (b_.has('D')) st.crc_d = int_word('D', 0, 99999, "cutter radius register");
+    if (g(gcode(40))) st.crc_side = cutter::Side::Off;
+    if (g(gcode(41))) st.crc_side = cutter::Side::Left;
+    if (g(gcode(42))) st.crc_side = cutter::Side::Right;
+    if (st.crc_side == cutter::Side::Off) return;
+    const int reg = st.crc_d.value_or(st.tool.current);
+    double radius = 0;
+    if (reg != 0) {
+        const ToolEntry* e = settings().tools.find(reg);
+        if (!e)
+            fail(b_.has('D') ? b_.loc_of('D') : b_.loc,
+                 fmt::format("cutter radius compensation: tool {} is not in the tool table", reg));
+        radius = e->diameter_mm / 2;
+    }
+    st.crc.radius_mm = radius;
+}
+
+// The side the compensator sees: one mirrored plane axis swaps G41 and G42 (CRC-13, MIR-4).
+void BlockRun::step_crc_effective() {
+    st.crc.plane = st.motion.plane;
+    st.crc.side = st.crc_side;
+    if (st.crc_side == cutter::Side::Off || xf().identity()) return;
+    const PlaneAxes pa = plane_axes(st.motion.plane);
+    const Eigen::Matrix3d L = xf().matrix().linear();
+    const double det = L(pa.first, pa.first) * L(pa.second, pa.second) -
+                       L(pa.first, pa.second) * L(pa.second, pa.first);
+    if (det < 0)
+        st.crc.side =
+            st.crc_side == cutter::Side::Left ? cutter::Side::Right : cutter::Side::Left;
+}
+
 void BlockRun::step_wcs() {
     for (int i = 0; i < kWorkSystems; ++i) {
         if (!g(gcode(54 + i))) continue;
@@ -635,6 +669,9 @@ void BlockRun::step_transforms() {
     };
     if (g(gcode(50))) xf_mut().clear_scaling();
     if (g(gcode(51))) {
+        if (st.crc_side != cutter::Side::Off)
+            fail(loc_g(gcode(51)),
+                 "G51 is not allowed while cutter compensation (G41/G42) is active");
         unsigned mask = 0;
         Eigen::Vector3d centre = centre_of(mask);
         Eigen::Vector3d f(1, 1, 1);
@@ -793,6 +830,8 @@ void BlockRun::step_machine_codes() {
 // on the axes written (REF-2, REF-3, REF-5).
 void BlockRun::g28() {
     require_no_scaling(gcode(28));
+    if (st.crc_side != cutter::Side::Off)
+        fail(loc_g(gcode(28)), "G28 is not allowed while cutter compensation (G41/G42) is active");
     if (!any_axis_word()) fail(loc_g(gcode(28)), "G28 needs the axes to return (X Y Z)");
     AxisVec mid_prog = st.pos.prog_mm;
     for (int a = 0; a < kMachineAxes; ++a)
@@ -1057,7 +1096,14 @@ void BlockRun::move_arc(bool ccw) {
 void BlockRun::step_motion() {
     if (axis_user_ && axis_user_->code >= gcode(34) && axis_user_->code <= gcode(37))
         return run_hole_pattern();
-    if (axis_user_) return;  // G92, G28, G51 … consumed the axis words
+    if (axis_user_) {
+        // G92, G28, G51 … consumed the axis words; a motion code only sets the mode.
+        if (motion_code_) {
+            st.cycle.cancel();
+            st.motion.motion = static_cast<Motion>(*motion_code_ / 10);
+        }
+        return;
+    }
     if (motion_code_) st.cycle.cancel();  // G00-8, G01-5: a group-01 code ends the cycle
     if (!motion_code_ && (st.cycle.active() || (cycle_code_ && *cycle_code_ != gcode(80))))
         return run_cycle();
@@ -1221,6 +1267,7 @@ void BlockRun::program_end(bool rewind) {
     xf_mut().clear();
     st.cycle.cancel();
     st.cycle_return_to_r = false;
+    st.crc_side = cutter::Side::Off;
     st.coord.g992_mm = {};
     st.coord.g992_active = false;
     st.motion = MotionModal{};
@@ -1255,7 +1302,7 @@ void BlockRun::step_stop() {
 // ---------------------------------------------------------------------------------------------
 
 Executor::Executor(CanonSink& sink, BackendConfig cfg, Settings settings)
-    : sink_(sink), cfg_(std::move(cfg)), settings_(std::move(settings)) {
+    : sink_(sink), cfg_(std::move(cfg)), settings_(std::move(settings)), crc_(sink, cfg_.cutter) {
     out_.reserve(16);
 }
 
@@ -1276,12 +1323,16 @@ void Executor::end_of_input(const SourceLoc& loc) {
 
 void Executor::commit(ExecState&& st, std::optional<ProgramTransform>&& xf,
                       std::optional<Settings>&& settings, std::vector<Canon>& out) {
+    const AxisVec machine_before = state_.pos.machine_mm;
     state_ = st;
     if (xf) xf_ = std::move(*xf);
     const bool settings_changed = settings && !(*settings == settings_);
     if (settings) settings_ = std::move(*settings);
-    for (const Canon& c : out) sink_.emit(c);
     if (settings_changed && settings_listener_) settings_listener_(settings_);
+    if (crc_.engaged() || state_.crc.side != cutter::Side::Off)
+        crc_.pass(out, state_.crc, machine_before);  // may throw a look-ahead error
+    else
+        for (const Canon& c : out) sink_.emit(c);
 }
 
 double Executor::machine_pos_mm(Axis axis) {

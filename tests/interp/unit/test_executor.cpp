@@ -185,7 +185,16 @@ TEST_F(ExecTest, UnsupportedCodesAreNamed) {
 }
 
 TEST_F(ExecTest, TwoAxisUsersInOneBlockIsAnError) {
-    EXPECT_EQ(error_of("G92 G01 X10"), "test.nc:7:5: G92 and G01 both use the axis words");
+    EXPECT_EQ(error_of("G92 G51 X10 P2"), "test.nc:7:5: G92 and G51 both use the axis words");
+}
+
+// S0's own CRC example starts with `G92 G0 X0 Y0`: the axis words belong to G92 and G00 only
+// becomes the modal motion.
+TEST_F(ExecTest, MotionCodeWithG92OnlySetsTheMode) {
+    run({"G01 X5 F100"});
+    EXPECT_EQ(run({"G92 G0 X0 Y0"}), (V{}));
+    EXPECT_EQ(exec->state().motion.motion, Motion::Rapid);
+    EXPECT_DOUBLE_EQ(exec->settings().offsets.g92[0], 5);
 }
 
 TEST_F(ExecTest, RejectedBlockChangesNothing) {
@@ -653,12 +662,70 @@ TEST(ExecCycles, GroupRulesAndReturnMode) {
     EXPECT_EQ(err("G99"), "ok");
     EXPECT_TRUE(exec.cycle_return_to_r());
     EXPECT_EQ(err("G40"), "ok");  // compensation is never on here, so cancelling is a no-op
-    EXPECT_EQ(err("G41 D1"), "test.nc:3:1: unsupported G code G41");
+    EXPECT_EQ(err("G41 D1"),
+              "test.nc:3:5: cutter radius compensation: tool 1 is not in the tool table");
     // A group-01 code ends the cycle: the next X-only block is a plain move, not a hole.
     EXPECT_EQ(err("G81 X1 Z-1 R1 F60"), "ok");
     EXPECT_EQ(err("G00 X2"), "ok");
     EXPECT_EQ(err("X3"), "ok");
     EXPECT_DOUBLE_EQ(exec.machine_pos_mm(Axis::Z), 1);  // R level of the G81 hole (G99)
+}
+
+}  // namespace
+}  // namespace interp
+
+namespace interp {
+namespace {
+
+struct Lines : CanonSink {
+    std::vector<std::string> text;
+    void emit(const Canon& c) override {
+        std::string t = to_text(c.cmd);
+        if (t.rfind("offsets", 0) != 0) text.push_back(t);
+    }
+};
+
+Settings radius5_tool() {
+    Settings s;
+    s.tools.at(1).diameter_mm = 10;
+    return s;
+}
+
+std::string run_err(Executor& e, const std::string& line) {
+    try {
+        e.execute(test::blk(line, 5));
+    } catch (const Error& err) {
+        return err.what();
+    }
+    return "ok";
+}
+
+TEST(ExecCrc, LeftOfTravelAndMirroringSwapsTheSide) {
+    Lines plain, mirrored;
+    Executor a(plain, BackendConfig{}, radius5_tool());
+    Executor b(mirrored, BackendConfig{}, radius5_tool());
+    for (auto* e : {&a, &b}) {
+        if (e == &b) e->execute(test::blk("G51.1 Y0"));
+        for (const char* l : {"G41 G01 X10 Y0 D1 F600", "X20", "G40 X30"}) e->execute(test::blk(l));
+        e->end_of_input(SourceLoc{"test.nc", 9, 1});
+    }
+    // Left of +X is +Y, so the compensated program path is at Y5. Mirroring Y must give the
+    // mirror image of that path, Y−5: the compensator sees G42 (CRC-13).
+    EXPECT_EQ(plain.text[1], "feed X10 Y5 Z0");
+    EXPECT_EQ(plain.text[2], "feed X20 Y5 Z0");
+    EXPECT_EQ(mirrored.text[1], "feed X10 Y-5 Z0");
+    EXPECT_EQ(mirrored.text[2], "feed X20 Y-5 Z0");
+}
+
+TEST(ExecCrc, ForbiddenCodesAndDAlone) {
+    Lines out;
+    Executor e(out, BackendConfig{}, radius5_tool());
+    EXPECT_EQ(run_err(e, "D1"), "ok");  // EX-35: D alone only selects the radius
+    EXPECT_EQ(run_err(e, "G41 G01 X10 F600"), "ok");
+    EXPECT_EQ(run_err(e, "G28 X0"),
+              "test.nc:5:1: G28 is not allowed while cutter compensation (G41/G42) is active");
+    EXPECT_EQ(run_err(e, "G51 X0 Y0 P2"),
+              "test.nc:5:1: G51 is not allowed while cutter compensation (G41/G42) is active");
 }
 
 }  // namespace
