@@ -14,8 +14,11 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kCentripetalShareArc = 0.8;
 constexpr double kCentripetalShareBlend = 0.95;
 // Shares of the jerk budget for the v^3 p''' and 3 v a p'' terms of curved elements.
-constexpr double kJerkCubicShare = 0.4;
-constexpr double kJerkCrossShare = 0.3;
+constexpr double kJerkCubicShareArc = 0.4;
+constexpr double kJerkCrossShareArc = 0.3;
+// Blends are short and mostly taken at constant speed: turning gets more of the jerk there.
+constexpr double kJerkCubicShareBlend = 0.7;
+constexpr double kJerkCrossShareBlend = 0.15;
 
 bool is_arc(const Element& e) {
     return e.kind == ElementKind::Arc;
@@ -25,12 +28,13 @@ double speed_cap(const Element& e, const ElementBounds& b, const AxisLimits& lim
                  const LimitShares& share) {
     double v = feed > 0 ? feed : kInf;
     double centripetal = is_arc(e) ? kCentripetalShareArc : kCentripetalShareBlend;
+    double cubic = is_arc(e) ? kJerkCubicShareArc : kJerkCubicShareBlend;
     for (int k = 0; k < kAxes; ++k) {
         if (b.g1[k] > 0) v = std::min(v, lim.vel_mm_s[k] / b.g1[k]);
         if (b.g2[k] > 0)
             v = std::min(v, std::sqrt(centripetal * share.acc * lim.acc_mm_s2[k] / b.g2[k]));
         if (b.g3[k] > 0 && lim.jerk_mm_s3[k] > 0)
-            v = std::min(v, std::cbrt(kJerkCubicShare * share.jerk * lim.jerk_mm_s3[k] / b.g3[k]));
+            v = std::min(v, std::cbrt(cubic * share.jerk * lim.jerk_mm_s3[k] / b.g3[k]));
     }
     return v;
 }
@@ -73,7 +77,8 @@ ElementLimits element_limits(const Element& e, const ElementBounds& b, const Axi
     for (int k = 0; k < kAxes; ++k) {
         if (lim.jerk_mm_s3[k] <= 0) continue;
         double m = share.jerk * lim.jerk_mm_s3[k];
-        if (b.g2[k] > 0) a = std::min(a, kJerkCrossShare * m / (3 * v * b.g2[k]));
+        double cross = is_arc(e) ? kJerkCrossShareArc : kJerkCrossShareBlend;
+        if (b.g2[k] > 0) a = std::min(a, cross * m / (3 * v * b.g2[k]));
         if (b.g1[k] > 0) j = std::min(j, (m - 3 * v * a * b.g2[k] - v * v * v * b.g3[k]) / b.g1[k]);
     }
     out.vcap_mm_s = v;
