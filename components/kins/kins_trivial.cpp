@@ -1,0 +1,27 @@
+// kins_trivial: LinuxCNC's trivkins as a HAL component (`loadrt kins_trivial
+// [coordinates=XYZ]`): joint N follows the axis named by the N-th letter of coordinates; a
+// letter given twice is a gantry (XYYZ: joints 1 and 2 both follow Y; Y's feedback comes from
+// joint 1).
+#include <stdexcept>
+
+#include "kins_common.hpp"
+
+namespace {
+
+struct KinsTrivial : kins::KinsInstance {
+    KinsTrivial() {
+        const std::string coordinates = arg("coordinates").value_or("XYZ");
+        try {
+            build(std::make_unique<motion::TrivialKinematics>(coordinates));
+        } catch (const std::invalid_argument& e) {
+            throw hal::Error(e.what());
+        }
+    }
+};
+
+}  // namespace
+
+HAL_COMPONENT(kins_trivial, KinsTrivial,
+              "Trivial kinematics: joint N follows the N-th letter of coordinates= (gantry: a "
+              "letter twice)",
+              "coordinates")
