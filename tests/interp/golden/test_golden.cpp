@@ -110,7 +110,9 @@ std::string run_case(const fs::path& dir) {
         interp::Executor exec(sink, cfg, settings);
         interp::Interpreter in(exec, exec, iopts);
         try {
-            if (!o.library.empty()) in.load_library((dir / o.library).string());
+            // In-memory sources keep the file names in diagnostics independent of the checkout.
+            if (!o.library.empty())
+                in.set_library(interp::Source::from_string(o.library, read_file(dir / o.library)));
             in.open(interp::Source::from_string("program.nc", read_file(dir / "program.nc")));
             in.run();
         } catch (const interp::Error& e) {
