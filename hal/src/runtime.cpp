@@ -41,6 +41,7 @@ InstanceContext* current_context() { return InstanceContext::current; }
 }  // namespace detail
 
 struct Runtime::Building {
+    explicit Building(Runtime& runtime) : rt(runtime) {}
     Runtime& rt;
     std::vector<std::string> pins, params, functs, streams;
     std::vector<std::pair<std::uint64_t, std::size_t>> blocks;  // segment allocations
@@ -1169,8 +1170,8 @@ void Runtime::cmd_start(const std::vector<std::string>& a, std::string& out) {
         for (Thread* t : thread_order_) t->next_deadline_ns = sim_now_ns_ + t->period_ns();
         return;
     }
-    static bool memory_locked = false;
-    if (!memory_locked && ::mlockall(MCL_CURRENT | MCL_FUTURE) == 0) memory_locked = true;
+    // Page faults on a realtime thread cost milliseconds; lock memory once, when permitted.
+    if (!memory_locked_ && ::mlockall(MCL_CURRENT | MCL_FUTURE) == 0) memory_locked_ = true;
     // Faster threads get higher priority, as in LinuxCNC.
     std::vector<Thread*> by_period = thread_order_;
     std::stable_sort(by_period.begin(), by_period.end(),

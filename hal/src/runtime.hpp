@@ -250,6 +250,7 @@ private:
     bool sim_clock_;
     std::int64_t sim_now_ns_ = 0;
     bool running_ = false;
+    bool memory_locked_ = false;
     int lock_ = 0;
     int next_component_id_ = 1;
 
