@@ -26,16 +26,19 @@ bool is_arc(const Element& e) {
 
 double speed_cap(const Element& e, const ElementBounds& b, const AxisLimits& lim, double feed,
                  const LimitShares& share) {
-    double v = feed > 0 ? feed : kInf;
     double centripetal = is_arc(e) ? kCentripetalShareArc : kCentripetalShareBlend;
     double cubic = is_arc(e) ? kJerkCubicShareArc : kJerkCubicShareBlend;
+    // Smallest allowed v, v^2 and v^3 over the axes first, then one root of each.
+    double v1 = feed > 0 ? feed : kInf, v2 = kInf, v3 = kInf;
     for (int k = 0; k < kAxes; ++k) {
-        if (b.g1[k] > 0) v = std::min(v, lim.vel_mm_s[k] / b.g1[k]);
-        if (b.g2[k] > 0)
-            v = std::min(v, std::sqrt(centripetal * share.acc * lim.acc_mm_s2[k] / b.g2[k]));
+        if (b.g1[k] > 0) v1 = std::min(v1, lim.vel_mm_s[k] / b.g1[k]);
+        if (b.g2[k] > 0) v2 = std::min(v2, centripetal * share.acc * lim.acc_mm_s2[k] / b.g2[k]);
         if (b.g3[k] > 0 && lim.jerk_mm_s3[k] > 0)
-            v = std::min(v, std::cbrt(cubic * share.jerk * lim.jerk_mm_s3[k] / b.g3[k]));
+            v3 = std::min(v3, cubic * share.jerk * lim.jerk_mm_s3[k] / b.g3[k]);
     }
+    double v = v1;
+    if (v2 < v * v) v = std::sqrt(v2);
+    if (v3 < v * v * v) v = std::cbrt(v3);
     return v;
 }
 

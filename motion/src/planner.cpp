@@ -245,7 +245,7 @@ std::size_t Planner::plan_and_emit(bool all) {
     for (std::size_t i = m - 1; i >= 1; --i) {
         double bound = std::min({gs[i - 1].vcap_mm_s, gs[i].vcap_mm_s, gs[i - 1].end_cap_mm_s});
         double back = reachable_speed_mm_s(vj_[i + 1], gs[i].length_mm, gs[i].tangent);
-        if (jerk_mode_)
+        if (jerk_mode_ && back < bound)
             back = std::max(back, reachable_speed_mm_s(0, gs[i].length_mm, gs[i].tangent));
         vj_[i] = std::min(bound, back);
     }
