@@ -109,9 +109,9 @@ void Server::serve(int fd) {
                     out = fmt::format("{}", fmt::join(words[1] == "command" ? runtime_.command_names()
                                                                             : runtime_.names(words[1]), "\n"));
                 } else if (words[0] == "@exists" && words.size() == 2) {
-                    out = runtime_.component_exists(words[1]) ? "1" : "0";
+                    out.assign(1, runtime_.component_exists(words[1]) ? '1' : '0');
                 } else if (words[0] == "@isready" && words.size() == 2) {
-                    out = runtime_.component_ready(words[1]) ? "1" : "0";
+                    out.assign(1, runtime_.component_ready(words[1]) ? '1' : '0');
                 } else if (words[0] == "@shutdown") {
                     open = false;
                     if (on_shutdown_) on_shutdown_();
