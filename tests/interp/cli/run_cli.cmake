@@ -20,3 +20,33 @@ endfunction()
 
 expect_run(bad 1)
 expect_run(good 0)
+
+# --settings with --save-settings: G92 and G923 are written back (atomically) and survive.
+file(MAKE_DIRECTORY ${WORK})
+file(WRITE ${WORK}/settings.txt "wcs 2 100 0 0 0 0 0\n")
+execute_process(COMMAND ${CNC} canon persist.nc --settings ${WORK}/settings.txt --save-settings
+                WORKING_DIRECTORY ${CASES} RESULT_VARIABLE status OUTPUT_QUIET ERROR_VARIABLE err)
+if(NOT status EQUAL 0)
+  message(FATAL_ERROR "cnc canon persist.nc: exit ${status}\n${err}")
+endif()
+file(READ ${WORK}/settings.txt saved)
+foreach(want "wcs 2 100 0 0 0 0 0\n" "g92 10 20 0 0 0 0\n" "tool 3 0 0 2.5 0\n")
+  string(FIND "${saved}" "${want}" at)
+  if(at EQUAL -1)
+    message(FATAL_ERROR "saved settings lack '${want}':\n${saved}")
+  endif()
+endforeach()
+if(EXISTS ${WORK}/settings.txt.tmp)
+  message(FATAL_ERROR "temporary settings file left behind")
+endif()
+# A bad settings file is a setup error (exit 2) naming file:line:col, and is left untouched.
+file(WRITE ${WORK}/bad.txt "g92 1 2\n")
+execute_process(COMMAND ${CNC} check good.nc --settings ${WORK}/bad.txt
+                WORKING_DIRECTORY ${CASES} RESULT_VARIABLE status OUTPUT_QUIET ERROR_VARIABLE err)
+if(NOT status EQUAL 2 OR NOT err MATCHES "bad.txt:1:1: settings: 'g92' needs 6 values, found 2")
+  message(FATAL_ERROR "bad settings: exit ${status}, stderr ${err}")
+endif()
+file(READ ${WORK}/bad.txt bad)
+if(NOT bad STREQUAL "g92 1 2\n")
+  message(FATAL_ERROR "bad settings file was changed")
+endif()
