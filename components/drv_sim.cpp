@@ -3,9 +3,11 @@
 // [mode=velocity|torque|ideal,…]`).
 //
 // Each cycle, in order:
-//   1. fault: latched by fault-inject or by |velocity| > max-vel (when max-vel > 0) or by a
-//      non-physical parameter (inertia <= 0 in torque mode); cleared while enable is FALSE and
-//      fault-inject is FALSE (the usual "toggle amp-enable to reset" of real drives).
+//   1. fault: latched by fault-inject, by |velocity| > max-vel (when max-vel > 0), by a
+//      non-physical parameter (inertia <= 0 in torque mode) or by a command that is not a
+//      finite number while enabled (a NaN must not reach the motor model, where it would stick
+//      forever); cleared while enable is FALSE and fault-inject is FALSE (the usual "toggle
+//      amp-enable to reset" of real drives).
 //   2. motion, only while enable is TRUE and there is no fault (otherwise the holding brake
 //      stops the motor at once: velocity 0, position held):
 //        ideal     pos += (pos-cmd - pos) * (1 - exp(-dt / lag)), pos = pos-cmd when lag = 0
@@ -37,7 +39,13 @@ namespace {
 enum class Mode { Velocity, Torque, Ideal };
 
 // Why the drive faulted, published in the fault-code param so a test or a UI can tell.
-enum FaultCode : std::uint32_t { kNoFault = 0, kInjected = 1, kOverspeed = 2, kBadParams = 3 };
+enum FaultCode : std::uint32_t {
+    kNoFault = 0,
+    kInjected = 1,
+    kOverspeed = 2,
+    kBadParams = 3,
+    kBadCommand = 4,
+};
 
 Mode parse_mode(const std::string& text) {
     if (text == "velocity") return Mode::Velocity;
@@ -118,6 +126,19 @@ struct DrvSim : hal::Instance {
             fault_ = kNoFault;
         }
         if (mode_ == Mode::Torque && !(inertia > 0.0) && fault_ == kNoFault) fault_ = kBadParams;
+        if (enable && !std::isfinite(active_command()) && fault_ == kNoFault) fault_ = kBadCommand;
+    }
+
+    double active_command() const noexcept {
+        switch (mode_) {
+            case Mode::Ideal:
+                return pos_cmd;
+            case Mode::Velocity:
+                return vel_cmd;
+            case Mode::Torque:
+                return torque_cmd;
+        }
+        return 0.0;
     }
 
     void move(double dt_s) noexcept {
