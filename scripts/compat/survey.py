@@ -351,6 +351,9 @@ def main():
             rc, err = run_linuxcnc(a.linuxcnc_halrun, path, cfg.run_ini if cfg else None, cwd, a.out,
                                    a.timeout)
             row["linuxcnc"], row["linuxcnc_detail"] = ("OK" if rc == 0 else "error"), ("" if rc == 0 else err)
+        prefix = os.path.normpath(a.tree) + os.sep
+        for k in ("detail", "syntax", "linuxcnc_detail"):
+            row[k] = row[k].replace(prefix, "")  # paths relative to the copied tree, as in `file`
         rows.append(row)
         print(f"[{n + 1}/{len(files)}] {row['status']:<24} {rel}", file=sys.stderr)
 
