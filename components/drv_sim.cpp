@@ -19,8 +19,12 @@
 //        torque    rigid motor and load: acc = (torque-cmd - damping * vel) / inertia,
 //                  vel += acc * dt, pos += vel * dt (semi-implicit Euler, stable for any
 //                  damping a pid can produce)
-//   3. encoder: counts = round(pos * scale), pos-fb = counts / scale; scale = 0 turns the
-//      quantisation off (pos-fb = pos, counts = 0).
+//   3. encoder: counts = round(pos * scale) - round(zero * scale), pos-fb = counts / scale;
+//      scale = 0 turns the quantisation off (pos-fb = pos - zero, counts = 0). zero starts at 0.
+//      Index marks sit every index-spacing units from index-offset (none when spacing is 0);
+//      `index` is TRUE in a cycle that crossed one. With index-enable TRUE, the first mark
+//      crossed becomes the new zero and index-enable is cleared, as LinuxCNC's encoder does on
+//      phase Z (the motion controller's homing to index relies on that handshake).
 //   4. switches from the true position, each with hysteresis switch-hyst (a switch that is on
 //      turns off only once the position is hyst back inside):
 //        home-sw     pos in [home-sw-min, home-sw-max]
@@ -72,6 +76,7 @@ struct DrvSim : hal::Instance {
 
     hal::In<bool> enable{this, "enable"};
     hal::In<bool> fault_inject{this, "fault-inject"};
+    hal::IO<bool> index_enable{this, "index-enable"};
     hal::In<double> pos_cmd{this, "pos-cmd"};
     hal::In<double> vel_cmd{this, "vel-cmd"};
     hal::In<double> torque_cmd{this, "torque-cmd"};
@@ -80,6 +85,7 @@ struct DrvSim : hal::Instance {
     hal::Out<double> vel_fb{this, "vel-fb"};
     hal::Out<double> motor_pos{this, "motor-pos"};
     hal::Out<std::int32_t> counts{this, "counts"};
+    hal::Out<bool> index{this, "index"};
     hal::Out<bool> home_sw{this, "home-sw"};
     hal::Out<bool> pos_lim_sw{this, "pos-lim-sw"};
     hal::Out<bool> neg_lim_sw{this, "neg-lim-sw"};
@@ -96,11 +102,14 @@ struct DrvSim : hal::Instance {
     hal::Param<double> pos_lim_pos{this, "pos-lim-pos", kInf};
     hal::Param<double> neg_lim_pos{this, "neg-lim-pos", -kInf};
     hal::Param<double> switch_hyst{this, "switch-hyst", 0.0};
+    hal::Param<double> index_spacing{this, "index-spacing", 0.0};
+    hal::Param<double> index_offset{this, "index-offset", 0.0};
     hal::Param<std::uint32_t> fault_code{this, "fault-code", 0, hal::ParamDir::RO};
 
     Mode mode_ = parse_mode(arg("mode").value_or("velocity"));
     double pos_ = 0.0;
     double vel_ = 0.0;
+    double zero_ = 0.0;  // true position that the encoder reads as 0 (moved by an index reset)
     bool home_on_ = false;
     bool pos_lim_on_ = false;
     bool neg_lim_on_ = false;
@@ -116,7 +125,29 @@ struct DrvSim : hal::Instance {
         }
         if (mode_ == Mode::Ideal) vel_ = p.s > 0.0 ? (pos_ - old_pos) / p.s : 0.0;
         if (max_vel > 0.0 && std::fabs(vel_) > max_vel && fault_ == kNoFault) fault_ = kOverspeed;
+        update_index(old_pos);
         publish();
+    }
+
+    // The first index mark crossed on the way from old_pos to pos_ (a fast motor may pass
+    // several in one period; hardware latches the first).
+    void update_index(double old_pos) noexcept {
+        const double spacing = index_spacing;
+        bool crossed = false;
+        if (spacing > 0.0) {
+            const double offset = index_offset;
+            const double k_old = std::floor((old_pos - offset) / spacing);
+            const double k_new = std::floor((pos_ - offset) / spacing);
+            if (k_new != k_old) {
+                crossed = true;
+                const double mark = offset + spacing * (k_new > k_old ? k_old + 1.0 : k_old);
+                if (index_enable) {
+                    zero_ = mark;
+                    index_enable = false;
+                }
+            }
+        }
+        index = crossed;
     }
 
     void update_fault() noexcept {
@@ -160,13 +191,14 @@ struct DrvSim : hal::Instance {
     void publish() noexcept {
         const double s = scale;
         if (s != 0.0) {
-            const auto n = static_cast<std::int64_t>(std::llround(pos_ * s));
+            const auto n = static_cast<std::int64_t>(std::llround(pos_ * s)) -
+                           static_cast<std::int64_t>(std::llround(zero_ * s));
             counts =
                 static_cast<std::int32_t>(static_cast<std::uint32_t>(n));  // wraps like a counter
             pos_fb = static_cast<double>(n) / s;
         } else {
             counts = 0;
-            pos_fb = pos_;
+            pos_fb = pos_ - zero_;
         }
         vel_fb = vel_;
         motor_pos = pos_;
