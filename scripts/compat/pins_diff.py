@@ -63,8 +63,22 @@ def parse_show(text):
             typ, direction, name = f[1], f[2], f[4] if len(f) > 4 else f[-1]
             if name.startswith("servo-thread"):
                 continue
-            items[(kind, name)] = f"{typ} {direction}"
+            items[(kind, name)] = f"{typ} {direction} = {normal_value(f[3])}"
     return items
+
+
+def normal_value(text):
+    """A shown value in one spelling for both runtimes: TRUE/FALSE, integers, %g floats."""
+    if text in ("TRUE", "FALSE"):
+        return text
+    try:
+        return str(int(text, 16) if text.lower().startswith("0x") else int(text))
+    except ValueError:
+        pass
+    try:
+        return f"{float(text):.6g}"
+    except ValueError:
+        return text
 
 
 def run(cmd, cwd):
@@ -102,6 +116,7 @@ def main():
     if only_ours:
         print(f"Not in LinuxCNC (not compared): {', '.join(only_ours)}\n")
     timing_re = re.compile(r"\.(time|tmax|tmax-increased)$")
+    print("Compared: name, type, direction and the value right after loadrt (the default).\n")
     print("Per-function timing objects are left out below: LinuxCNC 2.9 gives every function a\n"
           "`<funct>.time` s32 *pin* (CPU clocks), a `<funct>.tmax` s32 param and a\n"
           "`<funct>.tmax-increased` bit param; we give a `<funct>.time` s64 *param* and a\n"
