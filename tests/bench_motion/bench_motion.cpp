@@ -144,7 +144,7 @@ double throughput_seg_s(const PlannerConfig& cfg, const bench::FixtureProgram& p
 
 int main(int argc, char** argv) {
     CLI::App app{"Motion planner benchmark (tp_default settings by default)"};
-    std::string program = "/work/shared/bench/tp_default.ngc";
+    std::string program = MOTION_BENCH_DEFAULT_PROGRAM;
     std::vector<double> jerks = {0, 100000, 20000};
     Settings s;
     bool smoke = false;
@@ -186,7 +186,19 @@ int main(int argc, char** argv) {
                 r.max_vel[0], r.max_vel[1], r.max_vel[2], r.max_acc[0], r.max_acc[1], r.max_acc[2],
                 r.end_error_mm);
             if (excess > 0) print_excess(s, cfg, prog, excess);
-            if (smoke) break;
+            if (smoke) {
+                // The smoke run must at least end where the program ends, within the limits.
+                bool within = r.end_error_mm <= 1e-9;
+                for (int k = 0; k < kAxes; ++k)
+                    within = within && r.max_vel[k] <= s.vel_mm_s * (1 + 1e-9) &&
+                             r.max_acc[k] <= s.acc_mm_s2 * (1 + 1e-9);
+                if (!within) {
+                    std::fprintf(stderr,
+                                 "bench_motion: smoke run left the limits or the path end\n");
+                    return 1;
+                }
+                break;
+            }
         }
         if (!smoke) {
             for (double j : {0.0, jerks.back()}) {
