@@ -71,6 +71,7 @@ void write_hal_file(const fs::path& file, const fs::path& samples, const ChainSp
     out << "start\n";
     out << "loadusr -w halsampler -n " << cycles << ' ' << samples.string() << '\n';
     out << "getp and2." << spec.length - 1 << ".out\n";
+    out << "getp " << spec.thread << ".tmax\n";
 }
 
 }  // namespace
@@ -125,11 +126,16 @@ LinuxcncResult run_linuxcnc_chain(const ChainSpec& spec, const LinuxcncOptions& 
         fs::remove_all(dir);
         return r;
     }
-    if (log_text.find("TRUE") == std::string::npos) {
+    const auto true_at = log_text.find("TRUE\n");
+    if (true_at == std::string::npos) {
         r.why_not = "LinuxCNC chain did not propagate (tail of the chain is not TRUE)";
         fs::remove_all(dir);
         return r;
     }
+    // The line after the chain's TRUE is `getp servo-thread.tmax`, in TSC ticks.
+    std::istringstream after(log_text.substr(true_at + 5));
+    if (long long tmax_ticks = 0; after >> tmax_ticks)
+        r.tmax_ns = static_cast<double>(tmax_ticks) * 1e9 / r.tsc_hz;
     std::ifstream in(samples);
     std::vector<double> ticks;
     for (long long v; in >> v;) ticks.push_back(static_cast<double>(v));

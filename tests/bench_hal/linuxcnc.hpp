@@ -22,6 +22,7 @@ struct LinuxcncResult {
     std::string why_not;           // set when !ran: what was missing or what LinuxCNC said
     std::vector<double> cycle_ns;  // servo-thread.time per cycle, converted to ns
     double tsc_hz = 0;             // LinuxCNC 2.9 uspace reports thread time in TSC ticks
+    double tmax_ns = 0;            // servo-thread.tmax at the end of the run, converted to ns
     std::string rtapi_note;        // "POSIX non-realtime" or similar, from LinuxCNC's log
 };
 
