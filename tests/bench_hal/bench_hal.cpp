@@ -30,7 +30,6 @@ struct Settings {
     int sim_samples = 201;
     double rt_seconds = 10;
     double baseline_seconds = 1;
-    bool linuxcnc = true;
     bench::LinuxcncOptions lcnc;
 };
 

@@ -132,10 +132,15 @@ LinuxcncResult run_linuxcnc_chain(const ChainSpec& spec, const LinuxcncOptions& 
         fs::remove_all(dir);
         return r;
     }
-    // The line after the chain's TRUE is `getp servo-thread.tmax`, in TSC ticks.
+    // `getp servo-thread.tmax` (TSC ticks) prints the first all-digit line after the TRUE;
+    // LinuxCNC's notices may come in between.
     std::istringstream after(log_text.substr(true_at + 5));
-    if (long long tmax_ticks = 0; after >> tmax_ticks)
-        r.tmax_ns = static_cast<double>(tmax_ticks) * 1e9 / r.tsc_hz;
+    for (std::string line; std::getline(after, line);) {
+        if (!line.empty() && line.find_first_not_of("0123456789") == std::string::npos) {
+            r.tmax_ns = std::stod(line) * 1e9 / r.tsc_hz;
+            break;
+        }
+    }
     std::ifstream in(samples);
     std::vector<double> ticks;
     for (long long v; in >> v;) ticks.push_back(static_cast<double>(v));
