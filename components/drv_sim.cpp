@@ -17,8 +17,9 @@
 //                  vel += (vel-cmd - vel) * (1 - exp(-dt / vel-tc)), vel = vel-cmd when 0;
 //                  then pos += vel * dt
 //        torque    rigid motor and load: acc = (torque-cmd - damping * vel) / inertia,
-//                  vel += acc * dt, pos += vel * dt (semi-implicit Euler, stable for any
-//                  damping a pid can produce)
+//                  vel += acc * dt, pos += vel * dt (semi-implicit Euler: it keeps the
+//                  energy of an undamped motor under a P loop bounded, where explicit Euler
+//                  would let it grow; damping * dt / inertia must stay below 1)
 //   3. encoder: counts = round(pos * scale) - round(zero * scale), pos-fb = counts / scale;
 //      scale = 0 turns the quantisation off (pos-fb = pos - zero, counts = 0). zero starts at 0.
 //      Index marks sit every index-spacing units from index-offset (none when spacing is 0);
