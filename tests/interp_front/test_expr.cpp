@@ -70,6 +70,18 @@ TEST_F(ExprFixture, ComparisonAndLogicPrecedence) {
     EXPECT_EQ(eval("3<=2"), 0.0);
 }
 
+// cfg:expr_c_logic: && binds tighter than ||, everything else as in S0.
+TEST_F(ExprFixture, CLogicPrecedenceVariant) {
+    const Dialect& d = ncstudio_c_logic_dialect();
+    EXPECT_EQ(eval("1||0&&0", d), 1.0);  // 1||(0&&0)
+    EXPECT_EQ(eval("0&&1||1", d), 1.0);
+    EXPECT_EQ(eval("1+2==3&&!0", d), 1.0);
+    EXPECT_EQ(eval("2+3*4", d), 14.0);
+    EXPECT_EQ(eval("-2*3", d), -6.0);
+    EXPECT_EQ(find_dialect("ncstudio-c-logic"), &d);
+    EXPECT_EQ(find_dialect("iso"), nullptr);
+}
+
 // The manual's own examples (EX-17).
 TEST_F(ExprFixture, ManualExamples) {
     EXPECT_NEAR(eval("5+sin(5+abs(-8))"), 5.420167037, 1e-9);  // 5 + sin(13 rad)

@@ -325,6 +325,24 @@ TEST_F(InterpFixture, QueuedCustomCodeIsNotActiveYet) {
     EXPECT_EQ(exec.lines(), (Lines{5, 5, 2}));
 }
 
+// cfg:s_hook_prog: the configured subprogram runs after each block with S, before the block's
+// custom M codes, and an S inside it does not re-enter it.
+TEST_F(InterpFixture, SHookRunsAfterBlocksWithS) {
+    options.s_hook_program = 202;
+    run("G0 X1 S1000 M03\nG0 X2\nS2000\nM30\nO202\nG04 P7\nS1\nM17\n", true);
+    // Lines of main.nc as positive numbers, public.dat lines as 0: block 1, the hook (6, 7), then
+    // O203 for M03 (three library blocks), block 2, block 3 with the hook again, M30.
+    std::vector<int> lines;
+    for (const Block& b : exec.blocks) lines.push_back(b.loc.file == "main.nc" ? b.loc.line : 0);
+    EXPECT_EQ(lines, (Lines{1, 6, 7, 0, 0, 0, 2, 3, 6, 7, 4}));
+    EXPECT_EQ(exec.values('S'), (Values{1000, 1, 2000, 1}));
+}
+
+TEST_F(InterpFixture, ErrorSHookMissing) {
+    options.s_hook_program = 202;
+    EXPECT_EQ(run_error("G0 X1 S1000\n"), "main.nc:1:7: S hook subprogram O202 not found");
+}
+
 TEST_F(InterpFixture, LibrarySubprogramCallableByG65) {
     run("G65 P\"helper\"\nM30\n", true);
     EXPECT_EQ(exec.values('X'), (Values{77}));

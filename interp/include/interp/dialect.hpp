@@ -61,7 +61,9 @@ struct Dialect {
 const Dialect& ncstudio_dialect();
 // NcStudio with the V5.4 (S1) differences (cfg:ncstudio_v54_compat).
 const Dialect& ncstudio_v54_dialect();
-// By name: "ncstudio", "ncstudio-v54". nullptr when unknown.
+// NcStudio with C's precedence for && and || (cfg:expr_c_logic, EXP-05 REC).
+const Dialect& ncstudio_c_logic_dialect();
+// By name: "ncstudio", "ncstudio-v54", "ncstudio-c-logic". nullptr when unknown.
 const Dialect* find_dialect(std::string_view name);
 
 }  // namespace interp

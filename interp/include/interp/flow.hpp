@@ -51,14 +51,17 @@ struct CallFrame {
     bool started = false;        // queued frames (several custom codes in one block) wait
 };
 
-// CallFrame::custom_code of public.dat custom code G n is kCustomGFlag + n; of M n it is n.
+// CallFrame::custom_code of public.dat custom code G n is kCustomGFlag + n; of M n it is n; the
+// S-word hook (InterpreterOptions::s_hook_program) is kSHookCode.
 constexpr int kCustomGFlag = 1000;
+constexpr int kSHookCode = 2000;
 
 // A public.dat call produced by a custom M or G code of a block, queued behind the block.
 struct CustomCall {
-    int code = 0;  // M n -> n, G n -> kCustomGFlag + n
+    int code = 0;  // M n -> n, G n -> kCustomGFlag + n, S hook -> kSHookCode
     std::int64_t program = 0;
     LabelSite site;
+    Source* source = nullptr;  // where the subprogram is defined
 };
 
 }  // namespace interp

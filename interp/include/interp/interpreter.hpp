@@ -35,6 +35,9 @@ struct InterpreterOptions {
     // M99 in the main program restarts it (S0 §3.4). A checker turns this off so that a
     // looping program ends after one pass instead of running forever.
     bool main_m99_loops = true;
+    // cfg:s_hook_prog (CUS-4 REC): a subprogram (in public.dat, else in the program) run after
+    // every block with an S word, e.g. for gear changes. None by default.
+    std::optional<std::int64_t> s_hook_program;
 };
 
 class Interpreter {
@@ -72,6 +75,7 @@ class Interpreter {
     std::optional<CallFrame> resolve_call(const CallRequest& call);
     bool custom_code_active(int code) const;
     void collect_custom_codes(Block& b, bool has_call);
+    void queue_s_hook(const Block& b);
     void take_fixed_cycle_args(Block& b);
     void set_fixed_cycle_vars(const SourceLoc& loc);
     void handle_return(const ReturnRequest& r, const SourcePos& after_call);

@@ -18,6 +18,16 @@ constexpr std::array kNcStudioOps{
     BinOpRule{BinOp::Mul, 4, false}, BinOpRule{BinOp::Div, 4, false},
 };
 
+// cfg:expr_c_logic (EXP-05 REC): the same operators with C's order, && above ||.
+constexpr std::array kNcStudioCLogicOps{
+    BinOpRule{BinOp::Or, 1, false},  BinOpRule{BinOp::And, 2, false},
+    BinOpRule{BinOp::Eq, 3, false},  BinOpRule{BinOp::Ne, 3, false},
+    BinOpRule{BinOp::Gt, 3, false},  BinOpRule{BinOp::Lt, 3, false},
+    BinOpRule{BinOp::Ge, 3, false},  BinOpRule{BinOp::Le, 3, false},
+    BinOpRule{BinOp::Add, 4, false}, BinOpRule{BinOp::Sub, 4, false},
+    BinOpRule{BinOp::Mul, 5, false}, BinOpRule{BinOp::Div, 5, false},
+};
+
 // S1 §3.5 lists + - / * / / ^ / > < / ! / unary - ( ) |x| / functions. Its numbering would make
 // > bind tighter than +; EXP-06 REC uses the conventional order instead: comparisons loosest,
 // then + -, * /, unary, and ^ (right-associative) tightest.
@@ -71,6 +81,17 @@ const Dialect& ncstudio_dialect() {
     return d;
 }
 
+const Dialect& ncstudio_c_logic_dialect() {
+    static const Dialect d = [] {
+        Dialect c = make_ncstudio();
+        c.name = "ncstudio-c-logic";
+        c.binary_ops = kNcStudioCLogicOps;
+        c.unary_level = 6;
+        return c;
+    }();
+    return d;
+}
+
 const Dialect& ncstudio_v54_dialect() {
     static const Dialect d = make_ncstudio_v54();
     return d;
@@ -79,6 +100,7 @@ const Dialect& ncstudio_v54_dialect() {
 const Dialect* find_dialect(std::string_view name) {
     if (name == "ncstudio") return &ncstudio_dialect();
     if (name == "ncstudio-v54") return &ncstudio_v54_dialect();
+    if (name == "ncstudio-c-logic") return &ncstudio_c_logic_dialect();
     return nullptr;
 }
 

@@ -154,6 +154,7 @@ void Interpreter::execute_line(const SourceLoc& loc) {
     std::optional<CallFrame> call_frame;
     if (flow.call) call_frame = resolve_call(*flow.call);
     customs_.clear();
+    if (options_.s_hook_program && b.has('S') && !custom_code_active(kSHookCode)) queue_s_hook(b);
     if (library_) collect_custom_codes(b, flow.call.has_value());
     bool custom_g = false;
     for (const CustomCall& cc : customs_) custom_g = custom_g || cc.code >= kCustomGFlag;
@@ -231,7 +232,7 @@ void Interpreter::collect_custom_codes(Block& b, bool has_call) {
             ++i;
             continue;
         }
-        customs_.push_back(CustomCall{m, d.custom_m_base + m, *site});
+        customs_.push_back(CustomCall{m, d.custom_m_base + m, *site, library_.get()});
         b.m.erase_at(i);
         b.m_col.erase_at(i);
     }
@@ -249,10 +250,25 @@ void Interpreter::collect_custom_codes(Block& b, bool has_call) {
             throw Error(SourceLoc{b.loc.file, b.loc.line, b.g_col[i]},
                         "custom G" + std::to_string(n) + " and a subprogram call in one block");
         }
-        customs_.push_back(CustomCall{kCustomGFlag + n, d.custom_g_base + n, *site});
+        customs_.push_back(
+            CustomCall{kCustomGFlag + n, d.custom_g_base + n, *site, library_.get()});
         b.g.erase_at(i);
         b.g_col.erase_at(i);
     }
+}
+
+void Interpreter::queue_s_hook(const Block& b) {
+    // CUS-4 REC: a configured subprogram runs after every block that sets S (gear changes …),
+    // before the block's custom M codes; an S inside the hook does not trigger it again.
+    const std::int64_t program = *options_.s_hook_program;
+    for (Source* s : {library_.get(), main_.get()}) {
+        if (s == nullptr) continue;
+        if (const auto site = s->find_label(program)) {
+            customs_.push_back(CustomCall{kSHookCode, program, *site, s});
+            return;
+        }
+    }
+    throw Error(b.loc_of('S'), "S hook subprogram O" + std::to_string(program) + " not found");
 }
 
 void Interpreter::take_fixed_cycle_args(Block& b) {
@@ -344,7 +360,7 @@ void Interpreter::push_calls(std::optional<CallFrame>& call_frame, const SourceP
     for (std::size_t i = customs_.size(); i-- > 0;) {
         const CustomCall& cc = customs_[i];
         CallFrame f;
-        f.source = library_.get();
+        f.source = cc.source;
         f.body = cc.site.pos;
         f.return_source = current_;
         f.return_pos = after_call;
