@@ -2,9 +2,9 @@
 //   cnc canon PROGRAM   print the canonical command stream (native or LinuxCNC rs274 -g form)
 //   cnc check PROGRAM   run the whole program without motion; every error as file:line:col,
 //                       then a summary (extents, tools, path length)
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -158,9 +158,10 @@ int run_check(const CommonOptions& o, int max_errors) {
                interp::fmt_num(summary.rapid_length_mm()),
                interp::fmt_num(summary.feed_length_mm() + summary.rapid_length_mm()));
     const long secs = std::lround(summary.feed_time_s());
-    fmt::print("estimated feed time: {}:{:02d}:{:02d} (feed moves and dwells at 100 %, rapids "
-               "not included)\n",
-               secs / 3600, (secs / 60) % 60, secs % 60);
+    fmt::print(
+        "estimated feed time: {}:{:02d}:{:02d} (feed moves and dwells at 100 %, rapids "
+        "not included)\n",
+        secs / 3600, (secs / 60) % 60, secs % 60);
     return errors == 0 ? 0 : 1;
 }
 

@@ -27,9 +27,12 @@ struct PlaneAxes {
 };
 constexpr PlaneAxes plane_axes(Plane p) {
     switch (p) {
-        case Plane::ZX: return {2, 0, 1};
-        case Plane::YZ: return {1, 2, 0};
-        default: return {0, 1, 2};
+        case Plane::ZX:
+            return {2, 0, 1};
+        case Plane::YZ:
+            return {1, 2, 0};
+        default:
+            return {0, 1, 2};
     }
 }
 
@@ -39,7 +42,7 @@ namespace canon {
 
 // Per-block NcStudio move modifiers (G903, G905, G907, G908); all non-modal.
 struct MoveFlags {
-    bool force_full_override = false;  // G903: feed override fixed at 100 %
+    bool force_full_override = false;    // G903: feed override fixed at 100 %
     bool force_programmed_feed = false;  // G905: programmed F beats the "default speed" setting
     bool rotary_shortest_path = false;   // G907
     bool rotary_degrees = false;         // G908
@@ -87,7 +90,7 @@ struct Spindle {  // M03 / M04 / M05
     SpindleDir dir = SpindleDir::Stop;
 };
 struct SpindleOrient {};  // oriented spindle stop (inside G76/G87)
-struct Coolant {  // M08 / M09
+struct Coolant {          // M08 / M09
     bool flood = false;
 };
 struct SpindleClamp {  // M10 / M11 (V5.4)
@@ -107,9 +110,9 @@ struct ToolOffset {
 // The active coordinate offsets, sent whenever one changes. Informational: move end points
 // already include them. machine = work + wcs_origin + shift (tool offset aside).
 struct Offsets {
-    int wcs = 1;          // 1..6 = G54..G59
-    AxisVec wcs_mm{};     // selected work origin including the common/external offset
-    AxisVec shift_mm{};   // G92 shift plus the G992 temporary offset
+    int wcs = 1;         // 1..6 = G54..G59
+    AxisVec wcs_mm{};    // selected work origin including the common/external offset
+    AxisVec shift_mm{};  // G92 shift plus the G992 temporary offset
 };
 struct SelectPlane {
     Plane plane = Plane::XY;
@@ -146,7 +149,7 @@ struct LatchConfig {  // G916: which input latches this axis's encoder, at which
     int port = 0;
     bool level = false;
 };
-struct LatchClear {};  // G918
+struct LatchClear {};       // G918
 struct LatchStopDistance {  // G919 H
     int axis = 0;
 };
@@ -175,9 +178,9 @@ struct ProgramEnd {
 using CanonCommand =
     std::variant<canon::Traverse, canon::FeedLine, canon::Arc, canon::SetFeedRate,
                  canon::SetRapidRate, canon::SetFeedMode, canon::Dwell, canon::SetSpindleSpeed,
-                 canon::Spindle, canon::SpindleOrient, canon::Coolant, canon::SpindleClamp, canon::ToolChange,
-                 canon::SetToolNumber, canon::ToolOffset, canon::Offsets, canon::SelectPlane,
-                 canon::Units, canon::SetOutput, canon::WaitInput, canon::Sync,
+                 canon::Spindle, canon::SpindleOrient, canon::Coolant, canon::SpindleClamp,
+                 canon::ToolChange, canon::SetToolNumber, canon::ToolOffset, canon::Offsets,
+                 canon::SelectPlane, canon::Units, canon::SetOutput, canon::WaitInput, canon::Sync,
                  canon::ConditionalMove, canon::LatchConfig, canon::LatchClear,
                  canon::LatchStopDistance, canon::Message, canon::IntMessage, canon::HomeDone,
                  canon::Stop, canon::Warning, canon::ProgramEnd>;
@@ -190,7 +193,7 @@ struct Canon {
 
 // Receives the stream in program order. Called on the interpreter's thread.
 class CanonSink {
-public:
+  public:
     virtual ~CanonSink() = default;
     virtual void emit(const Canon& c) = 0;
 };

@@ -13,11 +13,11 @@ namespace interp {
 // One command per line in the native form (to_text); commands from a file other than the first
 // one seen are prefixed with that file's name.
 class NativePrinter final : public CanonSink {
-public:
+  public:
     explicit NativePrinter(std::FILE* out) : out_(out) {}
     void emit(const Canon& c) override;
 
-private:
+  private:
     std::FILE* out_;
     std::string main_file_;
 };
@@ -28,13 +28,13 @@ private:
 // units. Commands outside that subset are printed as COMMENT("native: …") so nothing is hidden.
 // Known differences are listed in docs/interp.md.
 class LinuxCncPrinter final : public CanonSink {
-public:
+  public:
     explicit LinuxCncPrinter(std::FILE* out) : out_(out) {}
     void emit(const Canon& c) override;
     // Prints the trailing ON_RESET() lines rs274 prints when it exits.
     void finish();
 
-private:
+  private:
     void line(const std::string& call);
     void preamble();
     void flush_block();
@@ -55,7 +55,7 @@ private:
 
 // Collects what `cnc check` reports.
 class SummarySink final : public CanonSink {
-public:
+  public:
     void emit(const Canon& c) override;
 
     bool any_motion() const { return moves_ > 0; }
@@ -68,7 +68,7 @@ public:
     double feed_time_s() const { return feed_time_; }
     int moves() const { return moves_; }
 
-private:
+  private:
     void extend(const std::array<double, 3>& p);
     void line_to(const AxisVec& end, bool rapid);
     void arc(const canon::Arc& a);
@@ -83,13 +83,13 @@ private:
 
 // Fans one stream out to several sinks.
 class TeeSink final : public CanonSink {
-public:
+  public:
     void add(CanonSink& s) { sinks_.push_back(&s); }
     void emit(const Canon& c) override {
         for (CanonSink* s : sinks_) s->emit(c);
     }
 
-private:
+  private:
     std::vector<CanonSink*> sinks_;
 };
 

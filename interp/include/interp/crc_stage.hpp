@@ -28,7 +28,7 @@ struct CrcBlockState {
 };
 
 class CrcStage {
-public:
+  public:
     explicit CrcStage(CanonSink& sink, cutter::Config cfg = {}) : sink_(sink), cfg_(cfg) {}
 
     // True while commands must go through the compensator.
@@ -36,9 +36,10 @@ public:
 
     // One committed block's commands. `machine_before` is where the machine was before the
     // block. Throws interp::Error on a compensation error.
-    void pass(const std::vector<Canon>& cmds, const CrcBlockState& s, const AxisVec& machine_before);
+    void pass(const std::vector<Canon>& cmds, const CrcBlockState& s,
+              const AxisVec& machine_before);
 
-private:
+  private:
     struct Held {
         Canon canon;
     };

@@ -24,20 +24,20 @@ namespace interp {
 
 // Dialect switches of the back end (FEATURES `cfg:` names in comments).
 struct BackendConfig {
-    bool v54_compat = false;          // cfg:ncstudio_v54_compat
-    bool ijk_incremental = true;      // cfg:ncstudio_ijk_incremental
-    bool g00_z_split = true;          // cfg:ncstudio_g00_z_split
-    double arc_tolerance_mm = 0.01;   // cfg:arc_tolerance
-    bool optional_stop = false;       // the operator's M01 switch
-    bool t_changes_tool = true;       // cfg:t_changes_tool (NcStudio 6th: T changes the tool)
-    bool end_stops_spindle = true;    // AUTOSTOPSPINDLE: M02/M30 stop spindle and coolant
-    double max_rapid_mm_s = 0;        // clamp for F in G00 blocks; 0 = no clamp
+    bool v54_compat = false;         // cfg:ncstudio_v54_compat
+    bool ijk_incremental = true;     // cfg:ncstudio_ijk_incremental
+    bool g00_z_split = true;         // cfg:ncstudio_g00_z_split
+    double arc_tolerance_mm = 0.01;  // cfg:arc_tolerance
+    bool optional_stop = false;      // the operator's M01 switch
+    bool t_changes_tool = true;      // cfg:t_changes_tool (NcStudio 6th: T changes the tool)
+    bool end_stops_spindle = true;   // AUTOSTOPSPINDLE: M02/M30 stop spindle and coolant
+    double max_rapid_mm_s = 0;       // clamp for F in G00 blocks; 0 = no clamp
     // The machine's default cutting feed, used by a feed move when no F was ever programmed
     // (NcStudio always has one; the manual's examples rely on it). 0 = such a move is an error.
     double default_feed_mm_s = 0;
-    AxisVec reference_mm{};           // G28 reference point, machine coordinates
-    AxisVec home_position_mm{};       // M902: machine origin position parameter per axis
-    std::uint64_t input_bits = 0;     // standalone model of the input ports
+    AxisVec reference_mm{};        // G28 reference point, machine coordinates
+    AxisVec home_position_mm{};    // M902: machine origin position parameter per axis
+    std::uint64_t input_bits = 0;  // standalone model of the input ports
     // Standalone model of G904: the machine coordinate (X, Y, Z) at which the watched input
     // changes. Without one, the input is taken to change at once and the axis does not move.
     std::array<std::optional<double>, 3> g904_trip_mm{};
@@ -58,16 +58,16 @@ struct ExecState {
     CoordModal coord;
     Position pos;
     IoState io;
-    cycles::CycleState cycle;      // active canned cycle and its modal data (G80 = none)
+    cycles::CycleState cycle;        // active canned cycle and its modal data (G80 = none)
     bool cycle_return_to_r = false;  // G99 (else G98)
     cutter::Side crc_side = cutter::Side::Off;  // G40/G41/G42 as programmed
-    std::optional<int> crc_d;                    // last D word (selects the radius)
-    CrcBlockState crc;  // what the compensator gets for this block (mirroring swaps the side)
+    std::optional<int> crc_d;                   // last D word (selects the radius)
+    CrcBlockState crc;     // what the compensator gets for this block (mirroring swaps the side)
     bool started = false;  // the initial offsets have been announced
 };
 
 class Executor final : public BlockExecutor, public MachineQuery {
-public:
+  public:
     Executor(CanonSink& sink, BackendConfig cfg, Settings settings = {});
 
     void execute(const Block& block) override;
@@ -96,7 +96,7 @@ public:
     const ProgramTransform& transform() const { return xf_; }
     const BackendConfig& config() const { return cfg_; }
 
-private:
+  private:
     void commit(ExecState&& st, std::optional<ProgramTransform>&& xf,
                 std::optional<Settings>&& settings, std::vector<Canon>& out);
 

@@ -42,7 +42,7 @@ struct CoolantModal {
 struct ToolModal {
     int current = 0;
     ToolLengthMode length_mode = ToolLengthMode::Off;
-    std::optional<int> h_register;  // H of the G43/G44 block; none = current tool (TLC-7 REC)
+    std::optional<int> h_register;      // H of the G43/G44 block; none = current tool (TLC-7 REC)
     std::array<double, 3> offset_mm{};  // the active tool offset vector
 };
 

@@ -16,7 +16,7 @@ struct ToolEntry {
 };
 
 class ToolTable {
-public:
+  public:
     // nullptr when the tool is not in the table.
     const ToolEntry* find(int tool) const {
         auto it = tools_.find(tool);
@@ -27,7 +27,7 @@ public:
     const std::map<int, ToolEntry>& entries() const { return tools_; }
     bool operator==(const ToolTable&) const = default;
 
-private:
+  private:
     std::map<int, ToolEntry> tools_;
 };
 

@@ -19,7 +19,7 @@
 namespace interp {
 
 class ProgramTransform {
-public:
+  public:
     // At least the 8 nested rotations FEATURES ROT-3 asks for, plus scaling and mirroring, and
     // room for the manual's "rotate and scale ten times" example.
     static constexpr std::size_t kMaxEntries = 32;
@@ -51,11 +51,11 @@ public:
     Eigen::Vector3d apply(const Eigen::Vector3d& p) const { return total_ * p; }
     Eigen::Vector3d inverse(const Eigen::Vector3d& p) const { return total_.inverse() * p; }
 
-private:
+  private:
     struct Entry {
         Kind kind;
         Eigen::Affine3d m;
-        unsigned mirror_mask;   // Mirror only
+        unsigned mirror_mask;    // Mirror only
         Eigen::Vector3d centre;  // Mirror only
     };
     bool has(Kind k) const;

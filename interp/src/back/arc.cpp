@@ -33,8 +33,8 @@ std::string solve_r(const ArcInput& in, ArcResult& out) {
     double r = std::abs(r_signed);
     if (r < d / 2 - in.tolerance_mm) {
         if (!in.v54_small_radius_is_half_circle)
-            return fmt::format("arc radius R{} is smaller than half the chord ({} mm)",
-                               fmt_num(r), fmt_num(d / 2));
+            return fmt::format("arc radius R{} is smaller than half the chord ({} mm)", fmt_num(r),
+                               fmt_num(d / 2));
         r = d / 2;
     }
     r = std::max(r, d / 2);

@@ -14,9 +14,12 @@ constexpr std::array<char, kMachineAxes> kAxisLetters{'X', 'Y', 'Z', 'A', 'B', '
 
 std::string_view plane_name(Plane p) {
     switch (p) {
-        case Plane::ZX: return "ZX";
-        case Plane::YZ: return "YZ";
-        default: return "XY";
+        case Plane::ZX:
+            return "ZX";
+        case Plane::YZ:
+            return "YZ";
+        default:
+            return "XY";
     }
 }
 
@@ -76,9 +79,12 @@ struct TextVisitor {
     }
     std::string operator()(const canon::Spindle& c) const {
         switch (c.dir) {
-            case SpindleDir::Cw: return "spindle cw";
-            case SpindleDir::Ccw: return "spindle ccw";
-            default: return "spindle stop";
+            case SpindleDir::Cw:
+                return "spindle cw";
+            case SpindleDir::Ccw:
+                return "spindle ccw";
+            default:
+                return "spindle stop";
         }
     }
     std::string operator()(const canon::SpindleOrient&) const { return "spindle-orient"; }
@@ -161,8 +167,12 @@ std::string fmt_num(double v) {
     return s;
 }
 
-std::string to_text(const CanonCommand& c) { return std::visit(TextVisitor{}, c); }
+std::string to_text(const CanonCommand& c) {
+    return std::visit(TextVisitor{}, c);
+}
 
-std::string to_text(const Canon& c) { return fmt::format("{} {}", c.loc.line, to_text(c.cmd)); }
+std::string to_text(const Canon& c) {
+    return fmt::format("{} {}", c.loc.line, to_text(c.cmd));
+}
 
 }  // namespace interp

@@ -31,9 +31,12 @@ std::string f4(double v) {
 
 const char* lcnc_plane(Plane p) {
     switch (p) {
-        case Plane::ZX: return "CANON_PLANE_XZ";
-        case Plane::YZ: return "CANON_PLANE_YZ";
-        default: return "CANON_PLANE_XY";
+        case Plane::ZX:
+            return "CANON_PLANE_XZ";
+        case Plane::YZ:
+            return "CANON_PLANE_YZ";
+        default:
+            return "CANON_PLANE_XY";
     }
 }
 
@@ -166,10 +169,10 @@ void LinuxCncPrinter::print(const CanonCommand& cmd) {
                 line(fmt::format("CHANGE_TOOL({})", c.tool));
             } else if constexpr (std::is_same_v<T, canon::ToolOffset>) {
                 tool_mm_ = c.offset_mm;
-                line(fmt::format("USE_TOOL_LENGTH_OFFSET({} {} {}, 0.0000 0.0000 0.0000, "
-                                 "0.0000 0.0000 0.0000)",
-                                 f4(unit(c.offset_mm[0])), f4(unit(c.offset_mm[1])),
-                                 f4(unit(c.offset_mm[2]))));
+                line(fmt::format(
+                    "USE_TOOL_LENGTH_OFFSET({} {} {}, 0.0000 0.0000 0.0000, "
+                    "0.0000 0.0000 0.0000)",
+                    f4(unit(c.offset_mm[0])), f4(unit(c.offset_mm[1])), f4(unit(c.offset_mm[2]))));
             } else if constexpr (std::is_same_v<T, canon::SelectPlane>) {
                 line(fmt::format("SELECT_PLANE({})", lcnc_plane(c.plane)));
             } else if constexpr (std::is_same_v<T, canon::Units>) {
@@ -277,14 +280,22 @@ void SummarySink::emit(const Canon& c) {
     std::visit(
         [&](const auto& v) {
             using T = std::decay_t<decltype(v)>;
-            if constexpr (std::is_same_v<T, canon::Traverse>) line_to(v.end_mm, true);
-            else if constexpr (std::is_same_v<T, canon::FeedLine>) line_to(v.end_mm, false);
-            else if constexpr (std::is_same_v<T, canon::Arc>) arc(v);
-            else if constexpr (std::is_same_v<T, canon::SetFeedRate>) feed_mm_s_ = v.feed_mm_s;
-            else if constexpr (std::is_same_v<T, canon::Dwell>) feed_time_ += v.seconds;
-            else if constexpr (std::is_same_v<T, canon::ToolChange>) tools_.insert(v.tool);
-            else if constexpr (std::is_same_v<T, canon::SetToolNumber>) tools_.insert(v.tool);
-            else if constexpr (std::is_same_v<T, canon::HomeDone>) pos_[v.axis] = v.position_mm;
+            if constexpr (std::is_same_v<T, canon::Traverse>)
+                line_to(v.end_mm, true);
+            else if constexpr (std::is_same_v<T, canon::FeedLine>)
+                line_to(v.end_mm, false);
+            else if constexpr (std::is_same_v<T, canon::Arc>)
+                arc(v);
+            else if constexpr (std::is_same_v<T, canon::SetFeedRate>)
+                feed_mm_s_ = v.feed_mm_s;
+            else if constexpr (std::is_same_v<T, canon::Dwell>)
+                feed_time_ += v.seconds;
+            else if constexpr (std::is_same_v<T, canon::ToolChange>)
+                tools_.insert(v.tool);
+            else if constexpr (std::is_same_v<T, canon::SetToolNumber>)
+                tools_.insert(v.tool);
+            else if constexpr (std::is_same_v<T, canon::HomeDone>)
+                pos_[v.axis] = v.position_mm;
         },
         c.cmd);
 }

@@ -8,7 +8,9 @@ namespace interp {
 
 namespace {
 
-int plane_code(Plane p) { return p == Plane::XY ? 17 : p == Plane::ZX ? 18 : 19; }
+int plane_code(Plane p) {
+    return p == Plane::XY ? 17 : p == Plane::ZX ? 18 : 19;
+}
 
 }  // namespace
 

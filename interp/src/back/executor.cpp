@@ -30,9 +30,9 @@ enum class GGroup {
     Rotation,
     NonModal,
     FeedMode,
-    Cycle,       // G73 … G89, G80
-    CycleReturn, // G98 / G99
-    Crc,         // G40 / G41 / G42
+    Cycle,        // G73 … G89, G80
+    CycleReturn,  // G98 / G99
+    Crc,          // G40 / G41 / G42
     Flag,
 };
 
@@ -43,40 +43,40 @@ struct GInfo {
 };
 
 constexpr GInfo kGTable[] = {
-    {gcode(0), GGroup::Motion, false},     {gcode(1), GGroup::Motion, false},
-    {gcode(2), GGroup::Motion, false},     {gcode(3), GGroup::Motion, false},
-    {gcode(4), GGroup::NonModal, false},   {gcode(17), GGroup::Plane, false},
-    {gcode(18), GGroup::Plane, false},     {gcode(19), GGroup::Plane, false},
-    {gcode(20), GGroup::Units, false},     {gcode(21), GGroup::Units, false},
-    {gcode(70), GGroup::Units, false},     {gcode(71), GGroup::Units, false},
-    {gcode(28), GGroup::NonModal, true},   {gcode(43), GGroup::ToolLength, false},
-    {gcode(44), GGroup::ToolLength, false}, {gcode(49), GGroup::ToolLength, false},
-    {gcode(50), GGroup::Scale, false},     {gcode(51), GGroup::Scale, true},
-    {gcode(50, 1), GGroup::Mirror, true},  {gcode(51, 1), GGroup::Mirror, true},
-    {gcode(53), GGroup::Flag, false},      {gcode(54), GGroup::Wcs, false},
-    {gcode(55), GGroup::Wcs, false},       {gcode(56), GGroup::Wcs, false},
-    {gcode(57), GGroup::Wcs, false},       {gcode(58), GGroup::Wcs, false},
-    {gcode(59), GGroup::Wcs, false},       {gcode(68), GGroup::Rotation, true},
-    {gcode(69), GGroup::Rotation, false},  {gcode(90), GGroup::Distance, false},
-    {gcode(91), GGroup::Distance, false},  {gcode(92), GGroup::NonModal, true},
-    {gcode(94), GGroup::FeedMode, false},  {gcode(903), GGroup::Flag, false},
-    {gcode(904), GGroup::NonModal, true},  {gcode(905), GGroup::Flag, false},
-    {gcode(906), GGroup::NonModal, false}, {gcode(907), GGroup::Flag, false},
-    {gcode(908), GGroup::Flag, false},     {gcode(916), GGroup::NonModal, false},
-    {gcode(73), GGroup::Cycle, false},     {gcode(74), GGroup::Cycle, false},
-    {gcode(76), GGroup::Cycle, false},     {gcode(80), GGroup::Cycle, false},
-    {gcode(81), GGroup::Cycle, false},     {gcode(82), GGroup::Cycle, false},
-    {gcode(83), GGroup::Cycle, false},     {gcode(84), GGroup::Cycle, false},
-    {gcode(85), GGroup::Cycle, false},     {gcode(86), GGroup::Cycle, false},
-    {gcode(87), GGroup::Cycle, false},     {gcode(88), GGroup::Cycle, false},
-    {gcode(89), GGroup::Cycle, false},     {gcode(98), GGroup::CycleReturn, false},
+    {gcode(0), GGroup::Motion, false},       {gcode(1), GGroup::Motion, false},
+    {gcode(2), GGroup::Motion, false},       {gcode(3), GGroup::Motion, false},
+    {gcode(4), GGroup::NonModal, false},     {gcode(17), GGroup::Plane, false},
+    {gcode(18), GGroup::Plane, false},       {gcode(19), GGroup::Plane, false},
+    {gcode(20), GGroup::Units, false},       {gcode(21), GGroup::Units, false},
+    {gcode(70), GGroup::Units, false},       {gcode(71), GGroup::Units, false},
+    {gcode(28), GGroup::NonModal, true},     {gcode(43), GGroup::ToolLength, false},
+    {gcode(44), GGroup::ToolLength, false},  {gcode(49), GGroup::ToolLength, false},
+    {gcode(50), GGroup::Scale, false},       {gcode(51), GGroup::Scale, true},
+    {gcode(50, 1), GGroup::Mirror, true},    {gcode(51, 1), GGroup::Mirror, true},
+    {gcode(53), GGroup::Flag, false},        {gcode(54), GGroup::Wcs, false},
+    {gcode(55), GGroup::Wcs, false},         {gcode(56), GGroup::Wcs, false},
+    {gcode(57), GGroup::Wcs, false},         {gcode(58), GGroup::Wcs, false},
+    {gcode(59), GGroup::Wcs, false},         {gcode(68), GGroup::Rotation, true},
+    {gcode(69), GGroup::Rotation, false},    {gcode(90), GGroup::Distance, false},
+    {gcode(91), GGroup::Distance, false},    {gcode(92), GGroup::NonModal, true},
+    {gcode(94), GGroup::FeedMode, false},    {gcode(903), GGroup::Flag, false},
+    {gcode(904), GGroup::NonModal, true},    {gcode(905), GGroup::Flag, false},
+    {gcode(906), GGroup::NonModal, false},   {gcode(907), GGroup::Flag, false},
+    {gcode(908), GGroup::Flag, false},       {gcode(916), GGroup::NonModal, false},
+    {gcode(73), GGroup::Cycle, false},       {gcode(74), GGroup::Cycle, false},
+    {gcode(76), GGroup::Cycle, false},       {gcode(80), GGroup::Cycle, false},
+    {gcode(81), GGroup::Cycle, false},       {gcode(82), GGroup::Cycle, false},
+    {gcode(83), GGroup::Cycle, false},       {gcode(84), GGroup::Cycle, false},
+    {gcode(85), GGroup::Cycle, false},       {gcode(86), GGroup::Cycle, false},
+    {gcode(87), GGroup::Cycle, false},       {gcode(88), GGroup::Cycle, false},
+    {gcode(89), GGroup::Cycle, false},       {gcode(98), GGroup::CycleReturn, false},
     {gcode(99), GGroup::CycleReturn, false}, {gcode(34), GGroup::NonModal, true},
-    {gcode(35), GGroup::NonModal, true},   {gcode(36), GGroup::NonModal, true},
-    {gcode(37), GGroup::NonModal, true},   {gcode(40), GGroup::Crc, false},
-    {gcode(41), GGroup::Crc, false},       {gcode(42), GGroup::Crc, false},
-    {gcode(918), GGroup::NonModal, false}, {gcode(919), GGroup::NonModal, false},
-    {gcode(921), GGroup::NonModal, true},  {gcode(922), GGroup::NonModal, true},
-    {gcode(923), GGroup::NonModal, true},  {gcode(992), GGroup::NonModal, true},
+    {gcode(35), GGroup::NonModal, true},     {gcode(36), GGroup::NonModal, true},
+    {gcode(37), GGroup::NonModal, true},     {gcode(40), GGroup::Crc, false},
+    {gcode(41), GGroup::Crc, false},         {gcode(42), GGroup::Crc, false},
+    {gcode(918), GGroup::NonModal, false},   {gcode(919), GGroup::NonModal, false},
+    {gcode(921), GGroup::NonModal, true},    {gcode(922), GGroup::NonModal, true},
+    {gcode(923), GGroup::NonModal, true},    {gcode(992), GGroup::NonModal, true},
 };
 
 const GInfo* find_g(int code) {
@@ -93,12 +93,11 @@ struct MInfo {
 };
 
 constexpr MInfo kMTable[] = {
-    {0, MGroup::Stop},       {1, MGroup::Stop},      {2, MGroup::Stop},
-    {30, MGroup::Stop},      {3, MGroup::Spindle},   {4, MGroup::Spindle},
-    {5, MGroup::Spindle},    {6, MGroup::ToolChange}, {903, MGroup::ToolChange},
-    {8, MGroup::Coolant},    {9, MGroup::Coolant},   {10, MGroup::Clamp},
-    {11, MGroup::Clamp},     {801, MGroup::Own},     {802, MGroup::Own},
-    {901, MGroup::Own},      {902, MGroup::Own},
+    {0, MGroup::Stop},         {1, MGroup::Stop},    {2, MGroup::Stop},    {30, MGroup::Stop},
+    {3, MGroup::Spindle},      {4, MGroup::Spindle}, {5, MGroup::Spindle}, {6, MGroup::ToolChange},
+    {903, MGroup::ToolChange}, {8, MGroup::Coolant}, {9, MGroup::Coolant}, {10, MGroup::Clamp},
+    {11, MGroup::Clamp},       {801, MGroup::Own},   {802, MGroup::Own},   {901, MGroup::Own},
+    {902, MGroup::Own},
 };
 
 const MInfo* find_m(int code) {
@@ -122,12 +121,14 @@ std::string mname(int code) {
 constexpr char kAxisLetter[kMachineAxes] = {'X', 'Y', 'Z', 'A', 'B', 'C'};
 constexpr char kCentreLetter[3] = {'I', 'J', 'K'};
 
-Eigen::Vector3d xyz(const AxisVec& v) { return {v[0], v[1], v[2]}; }
+Eigen::Vector3d xyz(const AxisVec& v) {
+    return {v[0], v[1], v[2]};
+}
 
 // One block's execution against copies of the state. Steps throw interp::Error; the caller
 // commits the copies only when run() returns.
 class BlockRun {
-public:
+  public:
     BlockRun(const Block& b, const BackendConfig& cfg, const ExecState& st,
              const ProgramTransform& xf, const Settings& settings, std::vector<Canon>& out)
         : st(st), b_(b), cfg_(cfg), base_xf_(xf), base_settings_(settings), out_(out) {}
@@ -138,7 +139,7 @@ public:
     std::optional<ProgramTransform> xf_copy;
     std::optional<Settings> settings_copy;
 
-private:
+  private:
     using Step = void (BlockRun::*)();
     static const Step kSteps[];
 
@@ -260,14 +261,13 @@ private:
 };
 
 const BlockRun::Step BlockRun::kSteps[] = {
-    &BlockRun::validate,       &BlockRun::announce_start,     &BlockRun::step_units,
-    &BlockRun::step_feed,      &BlockRun::step_spindle_speed, &BlockRun::step_tool,
-    &BlockRun::step_spindle,   &BlockRun::step_coolant,       &BlockRun::step_io,
-    &BlockRun::step_dwell,     &BlockRun::step_plane,         &BlockRun::announce_units,
-    &BlockRun::step_cutter_comp,   &BlockRun::step_tool_length,
-    &BlockRun::step_wcs,       &BlockRun::step_distance,      &BlockRun::step_transforms,
-    &BlockRun::step_settings_writes, &BlockRun::step_machine_codes, &BlockRun::step_cycle_modes,
-    &BlockRun::step_motion,
+    &BlockRun::validate,           &BlockRun::announce_start,     &BlockRun::step_units,
+    &BlockRun::step_feed,          &BlockRun::step_spindle_speed, &BlockRun::step_tool,
+    &BlockRun::step_spindle,       &BlockRun::step_coolant,       &BlockRun::step_io,
+    &BlockRun::step_dwell,         &BlockRun::step_plane,         &BlockRun::announce_units,
+    &BlockRun::step_cutter_comp,   &BlockRun::step_tool_length,   &BlockRun::step_wcs,
+    &BlockRun::step_distance,      &BlockRun::step_transforms,    &BlockRun::step_settings_writes,
+    &BlockRun::step_machine_codes, &BlockRun::step_cycle_modes,   &BlockRun::step_motion,
     &BlockRun::step_stop,          &BlockRun::step_crc_effective,
 };
 
@@ -286,8 +286,7 @@ void BlockRun::validate() {
         const GInfo* info = find_g(code);
         const SourceLoc loc{b_.loc.file, b_.loc.line, b_.g_col[i]};
         if (!info) fail(loc, fmt::format("unsupported G code {}", gname(code)));
-        if (code == gcode(91) && g(gcode(90)))
-            fail(loc, "G90 and G91 in the same block");
+        if (code == gcode(91) && g(gcode(90))) fail(loc, "G90 and G91 in the same block");
         const int grp = static_cast<int>(info->group);
         if (info->group != GGroup::Flag) {
             if (seen_group[grp] >= 0)
@@ -321,8 +320,8 @@ void BlockRun::validate() {
         const int grp = static_cast<int>(info->group);
         if (info->group != MGroup::Own) {
             if (seen_m[grp] >= 0)
-                fail(loc, fmt::format("{} and {} are in the same modal group",
-                                      mname(seen_m[grp]), mname(code)));
+                fail(loc, fmt::format("{} and {} are in the same modal group", mname(seen_m[grp]),
+                                      mname(code)));
             seen_m[grp] = code;
         }
     }
@@ -428,9 +427,8 @@ void BlockRun::step_feed() {
     // A canned-cycle block's F is the drilling feed even though G00 is the modal motion.
     const bool cycle_block =
         (cycle_code_ && *cycle_code_ != gcode(80)) || (st.cycle.active() && !motion_code_);
-    const bool rapid_mode =
-        !cycle_block &&
-        (motion_code_ ? *motion_code_ == gcode(0) : st.motion.motion == Motion::Rapid);
+    const bool rapid_mode = !cycle_block && (motion_code_ ? *motion_code_ == gcode(0)
+                                                          : st.motion.motion == Motion::Rapid);
     if (rapid_mode && !g(gcode(904))) {
         double r = f_mm_s;
         if (cfg_.max_rapid_mm_s > 0) r = std::min(r, cfg_.max_rapid_mm_s);
@@ -483,10 +481,14 @@ void BlockRun::step_tool() {
 }
 
 void BlockRun::step_spindle() {
-    if (m(3)) st.spindle.dir = SpindleDir::Cw;
-    else if (m(4)) st.spindle.dir = SpindleDir::Ccw;
-    else if (m(5)) st.spindle.dir = SpindleDir::Stop;
-    else return;
+    if (m(3))
+        st.spindle.dir = SpindleDir::Cw;
+    else if (m(4))
+        st.spindle.dir = SpindleDir::Ccw;
+    else if (m(5))
+        st.spindle.dir = SpindleDir::Stop;
+    else
+        return;
     emit(canon::Spindle{st.spindle.dir});
 }
 
@@ -569,10 +571,14 @@ void BlockRun::step_dwell() {
 
 void BlockRun::step_plane() {
     Plane p;
-    if (g(gcode(17))) p = Plane::XY;
-    else if (g(gcode(18))) p = Plane::ZX;
-    else if (g(gcode(19))) p = Plane::YZ;
-    else return;
+    if (g(gcode(17)))
+        p = Plane::XY;
+    else if (g(gcode(18)))
+        p = Plane::ZX;
+    else if (g(gcode(19)))
+        p = Plane::YZ;
+    else
+        return;
     st.motion.plane = p;
     emit(canon::SelectPlane{p});
 }
@@ -625,8 +631,7 @@ void BlockRun::step_crc_effective() {
     const double det = L(pa.first, pa.first) * L(pa.second, pa.second) -
                        L(pa.first, pa.second) * L(pa.second, pa.first);
     if (det < 0)
-        st.crc.side =
-            st.crc_side == cutter::Side::Left ? cutter::Side::Right : cutter::Side::Left;
+        st.crc.side = st.crc_side == cutter::Side::Left ? cutter::Side::Right : cutter::Side::Left;
 }
 
 void BlockRun::step_wcs() {
@@ -645,8 +650,8 @@ void BlockRun::step_distance() {
 
 void BlockRun::require_no_scaling(int code) const {
     if (xf().scaling_active())
-        fail(loc_g(code), fmt::format("{} is not allowed while scaling (G51) is active",
-                                      gname(code)));
+        fail(loc_g(code),
+             fmt::format("{} is not allowed while scaling (G51) is active", gname(code)));
 }
 
 // G50/G51 scaling, G50.1/G51.1 mirroring, G68/G69 rotation (SCL-*, MIR-*, ROT-*).
@@ -786,8 +791,7 @@ void BlockRun::write_g922() {
 
 void BlockRun::write_g923() {
     const SourceLoc loc = loc_g(gcode(923));
-    if (!b_.has('X') && !b_.has('Y') && !b_.has('Z'))
-        fail(loc, "G923 needs at least one of X Y Z");
+    if (!b_.has('X') && !b_.has('Y') && !b_.has('Z')) fail(loc, "G923 needs at least one of X Y Z");
     const int tool = b_.has('P') ? int_word('P', 0, 99999, "G923 tool") : st.tool.current;
     if (tool == 0) fail(loc, "G923: no current tool; give P<tool>");
     ToolEntry& e = settings_mut().tools.at(tool);
@@ -1123,10 +1127,18 @@ void BlockRun::step_motion() {
         if (arc_mode) fail(loc_g(gcode(53)), "G53 works only with G00 or G01");
     }
     switch (st.motion.motion) {
-        case Motion::Rapid: move_line(true, g53); break;
-        case Motion::Linear: move_line(false, g53); break;
-        case Motion::ArcCw: move_arc(false); break;
-        case Motion::ArcCcw: move_arc(true); break;
+        case Motion::Rapid:
+            move_line(true, g53);
+            break;
+        case Motion::Linear:
+            move_line(false, g53);
+            break;
+        case Motion::ArcCw:
+            move_arc(false);
+            break;
+        case Motion::ArcCcw:
+            move_arc(true);
+            break;
     }
 }
 
@@ -1165,15 +1177,18 @@ cycles::CycleWords BlockRun::cycle_words() const {
     if (b_.has('Q')) w.q_mm = mm('Q');
     if (b_.has('P')) w.p_ms = b_.get('P');
     // C-14: NcStudio documents K and uses L in its examples; both are the repeat count.
-    if (b_.has('K')) w.k = std::lround(b_.get('K'));
-    else if (b_.has('L')) w.k = std::lround(b_.get('L'));
+    if (b_.has('K'))
+        w.k = std::lround(b_.get('K'));
+    else if (b_.has('L'))
+        w.k = std::lround(b_.get('L'));
     return w;
 }
 
 void BlockRun::run_cycle() {
     if (!st.feed.feed_set) require_feed("a canned cycle");
     std::optional<cycles::CycleCode> code;
-    if (cycle_code_ && *cycle_code_ != gcode(80)) code = cycles::cycle_code_from_g(*cycle_code_ / 10);
+    if (cycle_code_ && *cycle_code_ != gcode(80))
+        code = cycles::cycle_code_from_g(*cycle_code_ / 10);
     try {
         const cycles::Expansion e =
             st.cycle.run_block(code, cycle_words(), cycle_context(), cfg_.cycles);
@@ -1194,9 +1209,9 @@ void BlockRun::run_hole_pattern() {
     if (b_.has('P')) w.p = b_.get('P');
     if (b_.has('K')) w.k = std::lround(b_.get('K'));
     try {
-        const auto holes = cycles::hole_pattern(code / 10, w, st.motion.incremental,
-                                                {st.pos.prog_mm[0], st.pos.prog_mm[1]},
-                                                st.cycle.active());
+        const auto holes =
+            cycles::hole_pattern(code / 10, w, st.motion.incremental,
+                                 {st.pos.prog_mm[0], st.pos.prog_mm[1]}, st.cycle.active());
         emit_cycle_steps(st.cycle.drill_at(holes, cycle_context(), cfg_.cycles));
     } catch (const cycles::CycleError& e) {
         fail(loc_g(code), e.what());

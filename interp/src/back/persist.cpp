@@ -42,7 +42,7 @@ std::vector<Token> split(const std::string& line) {
 }
 
 class LineParser {
-public:
+  public:
     LineParser(std::string_view name, int line, std::vector<Token> toks)
         : name_(name), line_(line), toks_(std::move(toks)) {}
 
@@ -65,8 +65,8 @@ public:
     int integer(std::size_t i, int lo, int hi) const {
         double v = num(i);
         if (v != static_cast<int>(v) || v < lo || v > hi)
-            fail(toks_[i].col, fmt::format("settings: '{}' must be an integer in {}..{}",
-                                           toks_[i].text, lo, hi));
+            fail(toks_[i].col,
+                 fmt::format("settings: '{}' must be an integer in {}..{}", toks_[i].text, lo, hi));
         return static_cast<int>(v);
     }
     AxisVec axes(std::size_t first) const {
@@ -76,7 +76,7 @@ public:
     }
     const std::vector<Token>& toks() const { return toks_; }
 
-private:
+  private:
     std::string_view name_;
     int line_;
     std::vector<Token> toks_;

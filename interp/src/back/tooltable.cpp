@@ -57,19 +57,36 @@ void parse_line(const std::string& line, std::string_view name, int line_no, Too
                 if (v < 0 || v != static_cast<int>(v)) err(word_col, "tool table: bad tool number");
                 tool = static_cast<int>(v);
                 break;
-            case 'P': e.pocket = static_cast<int>(v); break;
+            case 'P':
+                e.pocket = static_cast<int>(v);
+                break;
             case 'D':
                 if (v < 0) err(word_col, "tool table: negative diameter");
                 e.diameter_mm = v;
                 break;
-            case 'X': e.offset_mm[0] = v; break;
-            case 'Y': e.offset_mm[1] = v; break;
-            case 'Z': e.offset_mm[2] = v; break;
+            case 'X':
+                e.offset_mm[0] = v;
+                break;
+            case 'Y':
+                e.offset_mm[1] = v;
+                break;
+            case 'Z':
+                e.offset_mm[2] = v;
+                break;
             // Rotary/UVW offsets and lathe orientation words exist in LinuxCNC tables; a mill's
             // offset vector has no place for them, so they are read and ignored.
-            case 'A': case 'B': case 'C': case 'U': case 'V': case 'W':
-            case 'I': case 'J': case 'Q': break;
-            default: err(word_col, std::string("tool table: unknown word '") + c + "'");
+            case 'A':
+            case 'B':
+            case 'C':
+            case 'U':
+            case 'V':
+            case 'W':
+            case 'I':
+            case 'J':
+            case 'Q':
+                break;
+            default:
+                err(word_col, std::string("tool table: unknown word '") + c + "'");
         }
     }
     if (!any) return;  // blank or comment-only line

@@ -11,10 +11,10 @@
 
 #include <algorithm>
 #include <array>
-#include <optional>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -58,19 +58,25 @@ CaseOptions read_options(const fs::path& dir) {
     std::ifstream f(dir / "options");
     std::string key;
     while (f >> key) {
-        if (key == "dialect") f >> o.dialect;
-        else if (key == "tool-table") f >> o.tool_table;
-        else if (key == "library") f >> o.library;
-        else if (key == "settings") f >> o.settings;
+        if (key == "dialect")
+            f >> o.dialect;
+        else if (key == "tool-table")
+            f >> o.tool_table;
+        else if (key == "library")
+            f >> o.library;
+        else if (key == "settings")
+            f >> o.settings;
         else if (key == "g904-trip") {
             char axis = 0;
             double mm = 0;
             f >> axis >> mm;
             o.g904_trip_mm[axis - 'X'] = mm;
-        }
-        else if (key == "default-feed") f >> o.default_feed_mm_min;
-        else if (key == "optional-stop") o.optional_stop = true;
-        else if (key == "no-g00-split") o.no_split = true;
+        } else if (key == "default-feed")
+            f >> o.default_feed_mm_min;
+        else if (key == "optional-stop")
+            o.optional_stop = true;
+        else if (key == "no-g00-split")
+            o.no_split = true;
         else if (key == "format") {
             std::string v;
             f >> v;

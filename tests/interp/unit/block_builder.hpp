@@ -28,7 +28,8 @@ inline Block blk(const std::string& text, int line = 1) {
                                    text[i] == '.' || text[i] == '-' || text[i] == '+'))
             ++i;
         const std::string num = text.substr(start, i - start);
-        if (num.empty()) throw std::invalid_argument("blk: no number after " + std::string(1, letter));
+        if (num.empty())
+            throw std::invalid_argument("blk: no number after " + std::string(1, letter));
         const double v = std::strtod(num.c_str(), nullptr);
         if (letter == 'G') {
             const int whole = static_cast<int>(v);

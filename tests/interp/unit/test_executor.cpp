@@ -19,7 +19,7 @@ struct Recorder : CanonSink {
 };
 
 class ExecTest : public ::testing::Test {
-protected:
+  protected:
     void make(BackendConfig cfg = {}, Settings s = {}) {
         rec = Recorder{};
         exec = std::make_unique<Executor>(rec, cfg, s);
@@ -125,7 +125,8 @@ TEST_F(ExecTest, ARC_8_HelixAbsoluteAndIncrementalAgree) {
 TEST_F(ExecTest, ARC_1_PlanesZXAndYZUseKIAndJK) {
     run({"G01 F100"});
     // G18: (first, second) = (Z, X). From (0,0,0) CW to X20 about X10 (I10).
-    EXPECT_EQ(run({"G18 G02 X20 I10 K0"}), (V{"plane ZX", "arc ZX turns=-1 X20 Y0 Z0 centre=(10 0 0)"}));
+    EXPECT_EQ(run({"G18 G02 X20 I10 K0"}),
+              (V{"plane ZX", "arc ZX turns=-1 X20 Y0 Z0 centre=(10 0 0)"}));
     // G19: (Y, Z). From Y0 Z0 CCW to Y0 Z10 about Z5 (K5).
     EXPECT_EQ(run({"G19 G03 X20 Y0 Z10 J0 K5"}),
               (V{"plane YZ", "arc YZ turns=1 X20 Y0 Z10 centre=(20 0 5)"}));
@@ -274,7 +275,8 @@ TEST_F(ExecTest, G922_1_WritesOriginsInMachineCoordinates) {
     EXPECT_EQ(exec->settings().offsets.wcs[1][1], 6);
     EXPECT_EQ(exec->settings().offsets.common[2], -3);
     EXPECT_EQ(exec->settings().offsets.wcs[0][0], 7);
-    EXPECT_EQ(error_of("G922 X1 P6"), "test.nc:7:9: G922 offset type: P6 must be an integer in -4..5");
+    EXPECT_EQ(error_of("G922 X1 P6"),
+              "test.nc:7:9: G922 offset type: P6 must be an integer in -4..5");
     EXPECT_EQ(error_of("G922 X1 P-2"), "test.nc:7:9: G922: P must be -4, -1 or 0..5");
 }
 
@@ -413,7 +415,8 @@ TEST_F(ExecTest, TLC_7_WithoutHTheCurrentToolIsUsed) {
     Settings s;
     s.tools.at(2).offset_mm = {0, 0, 7};
     make({}, s);
-    EXPECT_EQ(run({"G43", "T2"}), (V{"tool-offset X0 Y0 Z0", "tool-change T2", "tool-offset X0 Y0 Z7"}));
+    EXPECT_EQ(run({"G43", "T2"}),
+              (V{"tool-offset X0 Y0 Z0", "tool-change T2", "tool-offset X0 Y0 Z7"}));
 }
 
 TEST_F(ExecTest, M03_1_SpindleSpeedIsKeptWhileStopped) {
@@ -423,7 +426,9 @@ TEST_F(ExecTest, M03_1_SpindleSpeedIsKeptWhileStopped) {
     EXPECT_EQ(error_of("S-5"), "test.nc:7:1: negative spindle speed S-5");
 }
 
-TEST_F(ExecTest, M08_1_Coolant) { EXPECT_EQ(run({"M08", "M09"}), (V{"coolant on", "coolant off"})); }
+TEST_F(ExecTest, M08_1_Coolant) {
+    EXPECT_EQ(run({"M08", "M09"}), (V{"coolant on", "coolant off"}));
+}
 
 TEST_F(ExecTest, M10_1_ClampIsAWarningIn6thAndACommandInV54) {
     EXPECT_EQ(run({"M10"}),
@@ -459,9 +464,9 @@ TEST_F(ExecTest, M01_1_OptionalStopFollowsTheSwitch) {
 TEST_F(ExecTest, M30_1_EndResetsModalStateAndStopsSpindle) {
     run({"G91 G20 G18 S100 M03 M08"});
     keep_offsets = true;
-    EXPECT_EQ(run({"M30"}), (V{"spindle stop", "coolant off",
-                               "offsets G54 origin=(X0 Y0 Z0) shift=(X0 Y0 Z0)",
-                               "program-end rewind"}));
+    EXPECT_EQ(run({"M30"}),
+              (V{"spindle stop", "coolant off", "offsets G54 origin=(X0 Y0 Z0) shift=(X0 Y0 Z0)",
+                 "program-end rewind"}));
     EXPECT_FALSE(exec->state().motion.incremental);
     EXPECT_EQ(exec->state().units.mm_per_unit, 1.0);
     EXPECT_EQ(exec->state().motion.plane, Plane::XY);
@@ -474,9 +479,8 @@ TEST_F(ExecTest, REF_2_G28ThroughIntermediatePoint) {
     make(cfg);
     run({"G00 X10 Y10 Z5"});
     // Intermediate (20, -, 10): Z rises first; then Z to the reference 50 alone with X to 0.
-    EXPECT_EQ(run({"G28 X20 Z10"}),
-              (V{"traverse X10 Y10 Z10", "traverse X20 Y10 Z10", "traverse X20 Y10 Z50",
-                 "traverse X0 Y10 Z50"}));
+    EXPECT_EQ(run({"G28 X20 Z10"}), (V{"traverse X10 Y10 Z10", "traverse X20 Y10 Z10",
+                                       "traverse X20 Y10 Z50", "traverse X0 Y10 Z50"}));
     EXPECT_EQ(error_of("G28"), "test.nc:7:1: G28 needs the axes to return (X Y Z)");
 }
 
@@ -630,7 +634,8 @@ TEST(ExecG904Sim, TriggerStopsTheAxisAndBadTriggersAreAlarms) {
         }
         return std::string("ok");
     };
-    EXPECT_EQ(g904(60, std::nullopt), "test.nc:4:1: G904: Z moves away from where its input changes (-5 mm)");
+    EXPECT_EQ(g904(60, std::nullopt),
+              "test.nc:4:1: G904: Z moves away from where its input changes (-5 mm)");
     EXPECT_EQ(g904(-60, 2.0), "test.nc:4:1: G904: Z travelled 2 mm without the input changing");
     EXPECT_EQ(g904(-60, 10.0), "ok");
     EXPECT_DOUBLE_EQ(exec.machine_pos_mm(Axis::Z), -5);

@@ -81,7 +81,8 @@ TEST(Settings, ErrorsNameFileLineAndColumn) {
     EXPECT_EQ(error_of_settings("wcs 7 0 0 0 0 0 0\n"),
               "s.txt:1:5: settings: '7' must be an integer in 1..6");
     EXPECT_EQ(error_of_settings("g92 0 0 x 0 0 0\n"), "s.txt:1:9: settings: 'x' is not a number");
-    EXPECT_EQ(error_of_settings("tool 1 0 0 5 -1\n"), "s.txt:1:14: settings: negative tool diameter");
+    EXPECT_EQ(error_of_settings("tool 1 0 0 5 -1\n"),
+              "s.txt:1:14: settings: negative tool diameter");
     EXPECT_EQ(error_of_settings("bogus 1\n"), "s.txt:1:1: settings: unknown entry 'bogus'");
 }
 
