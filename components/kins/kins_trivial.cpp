@@ -1,7 +1,7 @@
 // kins_trivial: LinuxCNC's trivkins as a HAL component (`loadrt kins_trivial
 // [coordinates=XYZ]`): joint N follows the axis named by the N-th letter of coordinates; a
 // letter given twice is a gantry (XYYZ: joints 1 and 2 both follow Y; Y's feedback comes from
-// joint 1).
+// joint 1). Without coordinates= every axis letter gets a joint in order, as trivkins does.
 #include <stdexcept>
 
 #include "kins_common.hpp"
@@ -10,7 +10,7 @@ namespace {
 
 struct KinsTrivial : kins::KinsInstance {
     KinsTrivial() {
-        const std::string coordinates = arg("coordinates").value_or("XYZ");
+        const std::string coordinates = arg("coordinates").value_or("XYZABCUVW");
         try {
             build(std::make_unique<motion::TrivialKinematics>(coordinates));
         } catch (const std::invalid_argument& e) {
