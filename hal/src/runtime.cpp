@@ -26,22 +26,13 @@ namespace hal {
 // Construction context: what the registration functions need while loadrt builds instances.
 
 namespace detail {
-struct InstanceContext {
-    Runtime* runtime;
-    Runtime::Building* building;
-    Component* component;
-    std::string name;
-    int index;
-    const std::map<std::string, std::string>* args;
-    bool has_functions = false;
-    static thread_local InstanceContext* current;
-};
 thread_local InstanceContext* InstanceContext::current = nullptr;
 InstanceContext* current_context() { return InstanceContext::current; }
 }  // namespace detail
 
-struct Runtime::Building {
-    explicit Building(Runtime& runtime) : rt(runtime) {}
+// Everything one loadrt line registered, so a failure can give it all back.
+struct LoadTransaction {
+    explicit LoadTransaction(Runtime& runtime) : rt(runtime) {}
     Runtime& rt;
     std::vector<std::string> pins, params, functs, streams;
     std::vector<std::pair<std::uint64_t, std::size_t>> blocks;  // segment allocations
@@ -87,8 +78,8 @@ std::string_view Instance::name() const noexcept { return ctx_->name; }
 int Instance::index() const noexcept { return ctx_->index; }
 
 std::optional<std::string> Instance::arg(std::string_view key) const {
-    auto it = ctx_->args->find(std::string(key));
-    if (it == ctx_->args->end()) return std::nullopt;
+    auto it = ctx_->args.find(std::string(key));
+    if (it == ctx_->args.end()) return std::nullopt;
     // A comma list gives one item per instance; a single item applies to every instance.
     std::vector<std::string> items;
     std::string item;
@@ -693,7 +684,7 @@ void Runtime::load_component(const std::string& name, const std::vector<std::str
                 }
     }
 
-    Building building{*this};
+    LoadTransaction building{*this};
     std::vector<std::unique_ptr<InstanceRecord>> made;
     auto shared_before = comp->shared_functs.size();
     std::vector<std::size_t> shared_sizes;
@@ -701,25 +692,22 @@ void Runtime::load_component(const std::string& name, const std::vector<std::str
     std::optional<std::string> failure;
     try {
         for (std::size_t i = 0; i < names.size(); ++i) {
-            detail::InstanceContext ctx{this, &building, comp, names[i], static_cast<int>(i), &kv};
-            detail::InstanceContext::current = &ctx;
-            std::unique_ptr<Instance> obj;
+            // The record owns the context before construction starts: the instance keeps a
+            // pointer to it for name() and arg(), and a failure frees both together.
+            auto rec = std::make_unique<InstanceRecord>();
+            rec->name = names[i];
+            rec->context.reset(new detail::InstanceContext{this, &building, comp, names[i], static_cast<int>(i), kv});
+            made.push_back(std::move(rec));
+            auto& made_rec = *made.back();
+            detail::InstanceContext::current = made_rec.context.get();
             try {
-                obj.reset(comp->descriptor->create());
+                made_rec.object.reset(comp->descriptor->create());
             } catch (...) {
                 detail::InstanceContext::current = nullptr;
                 throw;
             }
             detail::InstanceContext::current = nullptr;
-            // The context outlives construction: name()/arg() read it, so give it a home.
-            auto rec = std::make_unique<InstanceRecord>();
-            rec->name = names[i];
-            auto* home = new detail::InstanceContext(ctx);
-            home->building = nullptr;
-            home->args = new std::map<std::string, std::string>(kv);
-            obj->ctx_ = home;
-            rec->object = std::move(obj);
-            made.push_back(std::move(rec));
+            made_rec.context->building = nullptr;
         }
     } catch (const std::exception& e) {
         // The exception may have been made by the component, its vtable in the library:
@@ -782,12 +770,6 @@ void Runtime::unload_component(Component& c) {
     for (auto it = aliases_.begin(); it != aliases_.end();) {
         if (!pins_.count(it->second) && !params_.count(it->second)) it = aliases_.erase(it);
         else ++it;
-    }
-    for (auto& inst : c.instances) {
-        auto* ctx = inst->object->ctx_;
-        inst->object.reset();
-        delete ctx->args;
-        delete ctx;
     }
     // Stream rings stay allocated until the instance ends: halsampler may still be draining
     // one, and a ring reused under it would hand it another stream's records.

@@ -78,8 +78,32 @@ struct Funct {
 // stopped, plus fault).
 enum class InstanceState { Configured, Running, Stopped };
 
+}  // namespace hal
+
+namespace hal {
+struct LoadTransaction;
+}
+
+namespace hal::detail {
+// What an instance knows of itself (name, index, loadrt arguments); during loadrt also
+// where its registrations go.
+struct InstanceContext {
+    Runtime* runtime;
+    LoadTransaction* building;
+    Component* component;
+    std::string name;
+    int index;
+    std::map<std::string, std::string> args;
+    bool has_functions = false;
+    static thread_local InstanceContext* current;
+};
+}  // namespace hal::detail
+
+namespace hal {
+
 struct InstanceRecord {
     std::string name;
+    std::unique_ptr<detail::InstanceContext> context;  // declared first: outlives the object
     std::unique_ptr<Instance> object;
     InstanceState state = InstanceState::Configured;
 };
@@ -159,7 +183,7 @@ public:
     void shutdown();
 
     // Used by the registration functions while loadrt constructs instances.
-    struct Building;
+    friend struct LoadTransaction;
     friend void* detail::register_pin(Instance&, std::string_view, Type, Dir, Value, void*);
     friend void* detail::register_param(Instance&, std::string_view, Type, ParamDir, Value);
     friend void detail::register_function(Instance&, std::string_view, RealtimeFn, void*, bool);
@@ -167,7 +191,6 @@ public:
     friend void* detail::register_stream(Instance&, std::string_view, std::string_view, std::uint32_t);
 
 private:
-    friend struct Building;
     using Handler = void (Runtime::*)(const std::vector<std::string>&, std::string&);
     struct CommandSpec {
         const char* name;
