@@ -34,8 +34,14 @@ struct CommonOptions {
 
 void add_common(CLI::App& cmd, CommonOptions& o) {
     cmd.add_option("PROGRAM", o.program, "G-code program")->required()->check(CLI::ExistingFile);
-    cmd.add_option("--dialect", o.dialect, "ncstudio (6th edition) or ncstudio-v54")
-        ->check(CLI::IsMember({"ncstudio", "ncstudio-v54"}));
+    cmd.add_option("--dialect", o.dialect,
+                   "ncstudio (6th edition), ncstudio-v54 or another dialect the front end knows")
+        ->check(CLI::Validator(
+            [](std::string& name) {
+                return interp::find_dialect(name) ? std::string{}
+                                                  : "unknown dialect '" + name + "'";
+            },
+            "DIALECT"));
     cmd.add_option("-t,--tool-table", o.tool_table, "LinuxCNC tool table (.tbl)")
         ->check(CLI::ExistingFile);
     cmd.add_option("-l,--library", o.library, "public.dat subprogram library")
