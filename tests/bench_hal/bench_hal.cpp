@@ -214,7 +214,7 @@ void print_report(const Settings& s, const SimResult& sim, const RtResult& base,
                    b.ceil_ns / 1000.0, bench::quantile(rt.wakeup_sampled_ns, q) / 1000.0);
     }
     fmt::print("  {:<6} {:>9.1f} us (exact, every cycle)\n", "max", rt.wakeup_max_ns / 1000.0);
-    if (!rt.warning.empty()) fmt::print("warning from start: {}", rt.warning);
+    if (!rt.warning.empty()) fmt::print("start said: {}", rt.warning);
 }
 
 }  // namespace
