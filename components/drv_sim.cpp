@@ -32,6 +32,7 @@
 //        pos-lim-sw  pos >= pos-lim-pos
 //        neg-lim-sw  pos <= neg-lim-pos
 //      The defaults (±inf) never switch.
+// The motor starts at rest at start-pos (placed there when its thread first starts).
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -105,6 +106,7 @@ struct DrvSim : hal::Instance {
     hal::Param<double> switch_hyst{this, "switch-hyst", 0.0};
     hal::Param<double> index_spacing{this, "index-spacing", 0.0};
     hal::Param<double> index_offset{this, "index-offset", 0.0};
+    hal::Param<double> start_pos{this, "start-pos", 0.0};
     hal::Param<std::uint32_t> fault_code{this, "fault-code", 0, hal::ParamDir::RO};
 
     Mode mode_ = parse_mode(arg("mode").value_or("velocity"));
@@ -115,6 +117,17 @@ struct DrvSim : hal::Instance {
     bool pos_lim_on_ = false;
     bool neg_lim_on_ = false;
     std::uint32_t fault_ = kNoFault;
+    bool started_ = false;
+
+    // The motor is placed at start-pos when its thread first starts (a config may set the param
+    // after loadrt, so the constructor is too early); a later stop/start keeps the position.
+    void start() override {
+        if (started_) return;
+        started_ = true;
+        pos_ = start_pos;
+        vel_ = 0.0;
+        publish();
+    }
 
     void update(hal::Period p) noexcept {
         update_fault();
