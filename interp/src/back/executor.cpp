@@ -183,6 +183,8 @@ class BlockRun {
         return b_.loc;
     }
     bool g(int code) const { return b_.has_g(code); }
+    // Groups present in the block (set by validate): most blocks skip most steps at once.
+    bool group(GGroup grp) const { return (groups_ & (1u << static_cast<unsigned>(grp))) != 0; }
     bool m(int code) const { return b_.has_m(code); }
     template <typename T>
     void emit(T&& cmd) {
@@ -258,6 +260,7 @@ class BlockRun {
     std::optional<int> motion_code_;  // G00..G03 written in this block
     std::optional<int> cycle_code_;   // G73..G89 or G80 written in this block
     const GInfo* axis_user_ = nullptr;
+    unsigned groups_ = 0;
 };
 
 const BlockRun::Step BlockRun::kSteps[] = {
@@ -288,6 +291,7 @@ void BlockRun::validate() {
         if (!info) fail(loc, fmt::format("unsupported G code {}", gname(code)));
         if (code == gcode(91) && g(gcode(90))) fail(loc, "G90 and G91 in the same block");
         const int grp = static_cast<int>(info->group);
+        groups_ |= 1u << static_cast<unsigned>(grp);
         if (info->group != GGroup::Flag) {
             if (seen_group[grp] >= 0)
                 fail(loc, fmt::format("{} and {} are in the same modal group",
@@ -404,6 +408,7 @@ void BlockRun::update_tool_offset(const SourceLoc& loc) {
 // ---------------------------------------------------------------------------------------------
 
 void BlockRun::step_units() {
+    if (!group(GGroup::Units)) return;
     double mpu = st.units.mm_per_unit;
     if (g(gcode(20)) || g(gcode(70))) mpu = 25.4;
     if (g(gcode(21)) || g(gcode(71))) mpu = 1.0;
@@ -481,6 +486,7 @@ void BlockRun::step_tool() {
 }
 
 void BlockRun::step_spindle() {
+    if (b_.m.empty()) return;
     if (m(3))
         st.spindle.dir = SpindleDir::Cw;
     else if (m(4))
@@ -493,6 +499,7 @@ void BlockRun::step_spindle() {
 }
 
 void BlockRun::step_coolant() {
+    if (b_.m.empty()) return;
     if (m(8) || m(9)) {
         st.coolant.flood = m(8);
         emit(canon::Coolant{st.coolant.flood});
@@ -511,6 +518,7 @@ void BlockRun::step_coolant() {
 
 // M801 messages, M802 integer messages, M901 outputs, M902 homing done (S0 §3.10).
 void BlockRun::step_io() {
+    if (b_.m.empty()) return;
     if (m(801)) {
         if (!b_.msg) fail(loc_m(801), "M801 needs MSG \"text\"");
         emit(canon::Message{*b_.msg});
@@ -554,6 +562,7 @@ void BlockRun::step_io() {
 }
 
 void BlockRun::step_dwell() {
+    if (!group(GGroup::NonModal)) return;
     if (!g(gcode(4))) return;
     double seconds = 0;
     if (b_.has('P')) {
@@ -570,6 +579,7 @@ void BlockRun::step_dwell() {
 }
 
 void BlockRun::step_plane() {
+    if (!group(GGroup::Plane)) return;
     Plane p;
     if (g(gcode(17)))
         p = Plane::XY;
@@ -584,6 +594,7 @@ void BlockRun::step_plane() {
 }
 
 void BlockRun::step_tool_length() {
+    if (!group(GGroup::ToolLength)) return;
     if (!g(gcode(43)) && !g(gcode(44)) && !g(gcode(49))) return;
     const int code = g(gcode(43)) ? gcode(43) : g(gcode(44)) ? gcode(44) : gcode(49);
     if (code == gcode(49)) {
@@ -635,6 +646,7 @@ void BlockRun::step_crc_effective() {
 }
 
 void BlockRun::step_wcs() {
+    if (!group(GGroup::Wcs)) return;
     for (int i = 0; i < kWorkSystems; ++i) {
         if (!g(gcode(54 + i))) continue;
         st.coord.wcs = i;
@@ -644,6 +656,7 @@ void BlockRun::step_wcs() {
 }
 
 void BlockRun::step_distance() {
+    if (!group(GGroup::Distance)) return;
     if (g(gcode(90))) st.motion.incremental = false;
     if (g(gcode(91))) st.motion.incremental = true;
 }
@@ -658,6 +671,7 @@ void BlockRun::require_no_scaling(int code) const {
 // Centres are absolute program coordinates of the current frame even under G91 (EX-06 REC); a
 // centre axis not written is the current programmed position.
 void BlockRun::step_transforms() {
+    if (!group(GGroup::Scale) && !group(GGroup::Mirror) && !group(GGroup::Rotation)) return;
     auto centre_of = [&](unsigned& mask) {
         Eigen::Vector3d c = xyz(st.pos.prog_mm);
         mask = 0;
@@ -740,6 +754,7 @@ void BlockRun::step_transforms() {
 
 // Offset writes: G92, G921, G922, G923, G992 (S0 §3.5.1, §3.5.3).
 void BlockRun::step_settings_writes() {
+    if (!group(GGroup::NonModal)) return;
     if (g(gcode(92))) write_g92();
     if (g(gcode(921))) write_g921();
     if (g(gcode(922))) write_g922();
@@ -819,6 +834,7 @@ void BlockRun::write_g992() {
 }
 
 void BlockRun::step_machine_codes() {
+    if (!group(GGroup::NonModal)) return;
     if (g(gcode(28))) g28();
     if (g(gcode(904))) g904();
     if (g(gcode(906))) g906();
@@ -1147,6 +1163,7 @@ void BlockRun::step_motion() {
 // steps in program coordinates; they are transformed and emitted here like any other move.
 
 void BlockRun::step_cycle_modes() {
+    if (!group(GGroup::Cycle) && !group(GGroup::CycleReturn)) return;
     if (g(gcode(98))) st.cycle_return_to_r = false;
     if (g(gcode(99))) st.cycle_return_to_r = true;
     if (g(gcode(80))) st.cycle.cancel();
@@ -1306,6 +1323,7 @@ void BlockRun::program_end(bool rewind) {
 }
 
 void BlockRun::step_stop() {
+    if (b_.m.empty()) return;
     if (m(0)) emit(canon::Stop{false});
     if (m(1) && cfg_.optional_stop) emit(canon::Stop{true});
     if (m(2)) program_end(false);
