@@ -115,7 +115,8 @@ struct Block {
         g_col.clear();
         m.clear();
         m_col.clear();
-        for (std::uint32_t m = word_mask; m != 0; m &= m - 1) words[std::countr_zero(m)].reset();
+        for (std::uint32_t bits = word_mask; bits != 0; bits &= bits - 1)
+            words[std::countr_zero(bits)].reset();
         integer_literal_mask = 0;
         msg.reset();
         kw = NcKeywords{};
