@@ -9,7 +9,6 @@ packages=(
   libeigen3-dev
   nlohmann-json3-dev
   libcli11-dev
-  libinih-dev
   libedit-dev
   libgtest-dev
   libgmock-dev

@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "backends.hpp"
+#include "hal/types.hpp"
 
 namespace hal {
 
@@ -50,7 +51,13 @@ void interactive(Script& script, Backend& backend, const char* prompt) {
         ++line;
         if (text.find_first_not_of(" \t") == std::string::npos) continue;
         add_history(text.c_str());
-        if (text == "exit" || text == "quit") break;
+        std::vector<std::string> words;
+        try {
+            words = script.tokenize(text);
+        } catch (const Error&) {
+            // run_line below reports it
+        }
+        if (!words.empty() && (words[0] == "exit" || words[0] == "quit")) break;
         script.run_line(text);
     }
     g_completion_backend = nullptr;

@@ -428,6 +428,7 @@ const std::vector<Runtime::CommandSpec>& Runtime::commands() {
         {"unlock", &Runtime::cmd_unlock, 0, 1, kNone, "unlock [none|load|config|tune|all]"},
         {"advance", &Runtime::cmd_advance, 1, 1, kRun, "advance SECONDS   (simulated clock only)"},
         {"status", &Runtime::cmd_status, 0, 0, kNone, "status"},
+        {"help", &Runtime::cmd_help, 0, 1, kNone, "help [COMMAND]"},
     };
     return table;
 }
@@ -806,8 +807,6 @@ void Runtime::cmd_unload(const std::vector<std::string>& a, std::string& out) {
 Signal& Runtime::new_signal(const std::string& name, Type type) {
     check_item_name(name);
     if (signals_.count(name)) throw Error(fmt::format("signal '{}' already exists", name));
-    if (pins_.count(name) || params_.count(name))
-        throw Error(fmt::format("'{}' is already the name of a pin or parameter", name));
     auto slot = segment_->allocate(sizeof(Value));
     auto& s = signals_[name];
     s = std::make_unique<Signal>(Signal{name, type, slot, {}});
@@ -878,6 +877,10 @@ void Runtime::cmd_net(const std::vector<std::string>& a, std::string& out) {
         pins.push_back(&p);
     }
     if (pins.empty()) throw Error("net needs at least one pin; usage: net SIGNAL [=>|<=|<=>] PIN ...");
+    net_pins(sig_name, pins);
+}
+
+void Runtime::net_pins(const std::string& sig_name, std::vector<Pin*> pins) {
     auto it = signals_.find(sig_name);
     // Validate every pin against the signal as it would be after the whole line, so a
     // failure leaves nothing half-linked.
@@ -916,27 +919,37 @@ void Runtime::cmd_delsig(const std::vector<std::string>& a, std::string& out) {
     }
 }
 
-void Runtime::cmd_linkps(const std::vector<std::string>& a, std::string& out) {
+namespace {
+// The link commands take an optional arrow between their two names, as decoration.
+void check_optional_arrow(const std::vector<std::string>& a) {
     if (a.size() == 3 && !is_arrow(a[1])) throw Error(fmt::format("'{}' is not an arrow (=>, <= or <=>)", a[1]));
-    Pin& p = find_pin(a[0]);
-    Signal& s = find_signal(a.back());
+}
+}  // namespace
+
+void Runtime::link_checked(const std::string& pin_name, const std::string& signal_name) {
+    Pin& p = find_pin(pin_name);
+    Signal& s = find_signal(signal_name);
     check_link(p, s);
     link(p, s);
+}
+
+void Runtime::cmd_linkps(const std::vector<std::string>& a, std::string& out) {
+    check_optional_arrow(a);
+    link_checked(a[0], a.back());
 }
 
 void Runtime::cmd_linksp(const std::vector<std::string>& a, std::string& out) {
-    if (a.size() == 3 && !is_arrow(a[1])) throw Error(fmt::format("'{}' is not an arrow (=>, <= or <=>)", a[1]));
-    Signal& s = find_signal(a[0]);
-    Pin& p = find_pin(a.back());
-    check_link(p, s);
-    link(p, s);
+    check_optional_arrow(a);
+    link_checked(a.back(), a[0]);
 }
 
 void Runtime::cmd_linkpp(const std::vector<std::string>& a, std::string& out) {
-    if (a.size() == 3 && !is_arrow(a[1])) throw Error(fmt::format("'{}' is not an arrow (=>, <= or <=>)", a[1]));
+    check_optional_arrow(a);
+    // LinuxCNC's linkpp names the new signal after the first pin.
     Pin& p1 = find_pin(a[0]);
     Pin& p2 = find_pin(a.back());
-    cmd_net({p1.name, p1.name, p2.name}, out);
+    if (&p1 == &p2) throw Error(fmt::format("pin '{}' cannot be linked to itself", p1.name));
+    net_pins(p1.name, {&p1, &p2});
 }
 
 void Runtime::cmd_unlinkp(const std::vector<std::string>& a, std::string& out) {
@@ -1153,7 +1166,9 @@ void Runtime::cmd_start(const std::vector<std::string>& a, std::string& out) {
         return;
     }
     // Page faults on a realtime thread cost milliseconds; lock memory once, when permitted.
-    if (!memory_locked_ && ::mlockall(MCL_CURRENT | MCL_FUTURE) == 0) memory_locked_ = true;
+    // MCL_ONFAULT locks pages as they are touched, so the sparse segment reservation is not
+    // committed in full.
+    if (!memory_locked_ && ::mlockall(MCL_CURRENT | MCL_FUTURE | MCL_ONFAULT) == 0) memory_locked_ = true;
     // Faster threads get higher priority, as in LinuxCNC.
     std::vector<Thread*> by_period = thread_order_;
     std::stable_sort(by_period.begin(), by_period.end(),
@@ -1230,6 +1245,18 @@ int lock_bits(const std::vector<std::string>& a) {
 
 void Runtime::cmd_lock(const std::vector<std::string>& a, std::string& out) { lock_ |= lock_bits(a); }
 void Runtime::cmd_unlock(const std::vector<std::string>& a, std::string& out) { lock_ &= ~lock_bits(a); }
+
+void Runtime::cmd_help(const std::vector<std::string>& a, std::string& out) {
+    for (auto& c : commands())
+        if (a.empty() || a[0] == c.name) out += fmt::format("  {}\n", c.usage);
+    if (a.empty()) {
+        out += "  source FILE\n  echo WORDS...\n  loadusr [-W|-w|-i|-Wn NAME] PROGRAM [ARGS...]\n"
+               "  waitusr COMPONENT\n  PIN = VALUE   (same as setp)\n  quit | exit\n";
+    } else if (out.empty()) {
+        auto near = nearest_name(a[0], command_names());
+        throw Error(fmt::format("no command '{}'{}", a[0], near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near)));
+    }
+}
 
 void Runtime::cmd_status(const std::vector<std::string>& a, std::string& out) {
     out += fmt::format("instance {}  clock {}  threads {}\n", paths_.instance,

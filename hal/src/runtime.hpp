@@ -232,6 +232,7 @@ private:
     void cmd_unlock(const std::vector<std::string>& a, std::string& out);
     void cmd_advance(const std::vector<std::string>& a, std::string& out);
     void cmd_status(const std::vector<std::string>& a, std::string& out);
+    void cmd_help(const std::vector<std::string>& a, std::string& out);
 
     void load_threads_component(const std::vector<std::string>& a);
     void load_component(const std::string& name, const std::vector<std::string>& args);
@@ -251,6 +252,9 @@ private:
     Signal& new_signal(const std::string& name, Type type);
     void check_link(const Pin& pin, const Signal& sig) const;
     void link(Pin& pin, Signal& sig);
+    void link_checked(const std::string& pin_name, const std::string& signal_name);
+    // Links every pin to the signal (made if absent) after checking them all: all or none.
+    void net_pins(const std::string& sig_name, std::vector<Pin*> pins);
     void unlink(Pin& pin);
     void retarget(Pin& pin, std::uint64_t data_offset);
     void remove_pin(Pin& pin);

@@ -4,8 +4,6 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <INIReader.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
@@ -16,55 +14,45 @@
 
 #include <fmt/format.h>
 
+#include "hal/ini.hpp"
 #include "hal/types.hpp"
 
 namespace hal {
 
-class IniFile {
-public:
-    explicit IniFile(const std::string& path) : path_(path), reader_(path) {
-        if (reader_.ParseError() < 0) throw Error(fmt::format("cannot open INI file '{}'", path));
-        if (reader_.ParseError() > 0)
-            throw Error(fmt::format("{}:{}: INI syntax error", path, reader_.ParseError()));
-    }
-    std::optional<std::string> get(const std::string& section, const std::string& key) const {
-        if (!reader_.HasValue(section, key)) return std::nullopt;
-        // A repeated key (several HALFILE=) reads as lines; substitution takes the first.
-        auto v = reader_.Get(section, key, "");
-        return v.substr(0, v.find('\n'));
-    }
-    const std::string& path() const { return path_; }
-
-private:
-    std::string path_;
-    INIReader reader_;
-};
-
 Script::Script(Backend& backend) : backend_(backend) {}
 Script::~Script() = default;
 
-void Script::load_ini(const std::string& path) { ini_ = std::make_unique<IniFile>(path); }
+void Script::load_ini(const std::string& path) { ini_ = std::make_unique<IniFile>(IniFile::load(path)); }
 
 std::string Script::substitute(const std::string& line) const {
     std::string out;
     for (std::size_t i = 0; i < line.size();) {
         char c = line[i];
         if (c == '[') {
+            // [SECTION]KEY, or [SECTION](KEY) when the key must be followed by more text.
             auto close = line.find(']', i);
-            std::size_t key_end = close == std::string::npos ? close : close + 1;
-            while (key_end != std::string::npos && key_end < line.size() &&
-                   (std::isalnum(static_cast<unsigned char>(line[key_end])) || line[key_end] == '_' ||
-                    line[key_end] == '-' || line[key_end] == '.'))
-                ++key_end;
-            if (close != std::string::npos && key_end > close + 1) {
+            std::size_t key_begin = close == std::string::npos ? close : close + 1;
+            std::size_t key_end = key_begin;
+            bool parenthesized = key_begin != std::string::npos && key_begin < line.size() && line[key_begin] == '(';
+            if (parenthesized) {
+                key_end = line.find(')', key_begin);
+                if (key_end == std::string::npos) throw Error("unterminated [SECTION](KEY)");
+                ++key_begin;
+            } else {
+                while (key_end != std::string::npos && key_end < line.size() &&
+                       (std::isalnum(static_cast<unsigned char>(line[key_end])) || line[key_end] == '_' ||
+                        line[key_end] == '-' || line[key_end] == '.'))
+                    ++key_end;
+            }
+            if (close != std::string::npos && key_end > key_begin) {
                 auto section = line.substr(i + 1, close - i - 1);
-                auto key = line.substr(close + 1, key_end - close - 1);
+                auto key = line.substr(key_begin, key_end - key_begin);
                 if (!ini_)
                     throw Error(fmt::format("[{}]{} needs an INI file (halrun -i FILE)", section, key));
                 auto v = ini_->get(section, key);
                 if (!v) throw Error(fmt::format("[{}]{} is not in INI file '{}'", section, key, ini_->path()));
                 out += *v;
-                i = key_end;
+                i = parenthesized ? key_end + 1 : key_end;
                 continue;
             }
         }
@@ -132,7 +120,14 @@ std::vector<std::string> Script::tokenize(const std::string& raw) const {
 
 void Script::run_words(const std::vector<std::string>& words, std::string& out) {
     const std::string& cmd = words[0];
-    if (cmd == "echo") {
+    // `pin = value` is LinuxCNC's shorthand for setp.
+    if (words.size() == 3 && words[1] == "=") {
+        backend_.exec({"setp", words[0], words[2]}, out);
+        return;
+    }
+    if (cmd == "quit" || cmd == "exit") {
+        quit_ = true;
+    } else if (cmd == "echo") {
         std::vector<std::string> rest(words.begin() + 1, words.end());
         out += fmt::format("{}\n", fmt::join(rest, " "));
     } else if (cmd == "source") {
@@ -182,7 +177,7 @@ bool Script::run_file(const std::string& path) {
     std::string physical, logical;
     int line_no = 0, first_line = 0;
     bool ok = true;
-    while (ok && std::getline(in, physical)) {
+    while (ok && !quit_ && std::getline(in, physical)) {
         ++line_no;
         if (logical.empty()) first_line = line_no;
         if (!physical.empty() && physical.back() == '\r') physical.pop_back();
@@ -194,8 +189,9 @@ bool Script::run_file(const std::string& path) {
         ok = run_line(logical, path, first_line);
         logical.clear();
     }
-    if (ok && !logical.empty()) ok = run_line(logical, path, first_line);
+    if (ok && !quit_ && !logical.empty()) ok = run_line(logical, path, first_line);
     file_stack_.pop_back();
+    if (file_stack_.empty()) quit_ = false;  // quit ends the outermost file, not the session
     return ok;
 }
 

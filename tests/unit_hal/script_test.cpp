@@ -89,3 +89,60 @@ TEST(Script, LoadusrWaitsForExitAndReportsFailure) {
 
 }  // namespace
 }  // namespace hal::test
+
+#include "hal/ini.hpp"
+
+namespace hal::test {
+namespace {
+
+TEST(Ini, ReadsLinuxCncStyleFiles) {
+    auto ini = IniFile::parse(
+        "# comment\n[EMC]\n  MACHINE = my mill   \nJUST WORDS WITHOUT EQUALS\n; other comment\n"
+        "[HAL]\nHALFILE = a.hal\nHALFILE = b.hal\n[AXIS_X]\nMAX_VELOCITY = 100 \\\n   .5\nLIMIT = abc\n",
+        "m.ini");
+    EXPECT_EQ(ini.get("EMC", "MACHINE"), "my mill");
+    EXPECT_EQ(ini.all("HAL", "HALFILE"), (std::vector<std::string>{"a.hal", "b.hal"}));
+    EXPECT_EQ(ini.get("HAL", "HALFILE", 1), "b.hal");
+    EXPECT_EQ(ini.get("AXIS_X", "MAX_VELOCITY"), "100 .5");
+    EXPECT_FALSE(ini.get("EMC", "JUST WORDS WITHOUT EQUALS"));
+    EXPECT_EQ(ini.find("AXIS_X", "LIMIT")->line, 12);
+    try {
+        ini.get_number("AXIS_X", "LIMIT");
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()), "m.ini:12: [AXIS_X]LIMIT = 'abc' is not a number");
+    }
+    EXPECT_FALSE(ini.get_number("AXIS_Y", "LIMIT"));
+}
+
+TEST(Ini, IncludeContinuesTheSectionAndNamesItsFile) {
+    auto part = temp_file("part.inc", "P = 7\n\nI = 2\n");
+    auto main_ini = temp_file("main.ini", fmt::format("[JOINT_0]\n#INCLUDE {}\nD = 1\n", part));
+    auto ini = IniFile::load(main_ini);
+    EXPECT_EQ(ini.get("JOINT_0", "P"), "7");
+    EXPECT_EQ(ini.get("JOINT_0", "D"), "1");
+    EXPECT_EQ(ini.find("JOINT_0", "I")->file, part);
+    EXPECT_EQ(ini.find("JOINT_0", "I")->line, 3);
+    auto broken = temp_file("broken.ini", "[X]\n#INCLUDE /nonexistent/file.inc\n");
+    try {
+        IniFile::load(broken);
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find(fmt::format("{}:2: cannot open INI file '/nonexistent/file.inc'", broken)),
+                  std::string::npos);
+    }
+}
+
+TEST(Script, ParenthesizedKeysQuitAndAssignment) {
+    Recorder r;
+    Script s(r);
+    s.load_ini(temp_file("p.ini", "[HOSTMOT2]\nBOARD = 5i25\n"));
+    EXPECT_EQ(s.tokenize("loadrt hm2_[HOSTMOT2](BOARD)x"), (std::vector<std::string>{"loadrt", "hm2_5i25x"}));
+    auto hal = temp_file("q.hal", "x.in = 3\nquit\nsetp never 1\n");
+    EXPECT_TRUE(s.run_file(hal));
+    ASSERT_EQ(r.seen.size(), 1u);
+    EXPECT_EQ(r.seen[0], (std::vector<std::string>{"setp", "x.in", "3"}));
+}
+
+}  // namespace
+}  // namespace hal::test

@@ -24,7 +24,7 @@ public:
     virtual bool component_ready(const std::string& name) = 0;
 };
 
-class IniFile;
+class IniFile;  // hal/ini.hpp
 
 class Script {
 public:
@@ -54,6 +54,7 @@ private:
     std::unique_ptr<IniFile> ini_;
     std::vector<std::string> file_stack_;  // for `source` cycles
     std::map<std::string, pid_t> children_;  // component name -> pid
+    bool quit_ = false;  // `quit` or `exit` read from a file
 };
 
 }  // namespace hal
