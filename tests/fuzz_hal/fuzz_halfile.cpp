@@ -39,7 +39,9 @@ bool allowed(const std::vector<std::string>& words) {
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-    static Harness* h = new Harness;  // one instance for the whole run; reset per input
+    // One instance for the whole run, reset per input; a static so exit removes its segment.
+    static Harness harness;
+    Harness* h = &harness;
     std::string text(reinterpret_cast<const char*>(data), size);
     std::string line, out;
     auto run = [&](const std::string& logical) {
