@@ -1,6 +1,7 @@
 // Property tests: the transform chain against matrices built independently with Eigen, and arc
 // geometry invariants (start and end on the circle, centre where the definition puts it), over
 // seeded random inputs so failures reproduce.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -8,7 +9,9 @@
 #include <numbers>
 #include <random>
 
+#include "block_builder.hpp"
 #include "interp/arc.hpp"
+#include "interp/executor.hpp"
 #include "interp/transform.hpp"
 
 namespace interp {
@@ -150,7 +153,8 @@ TEST(ArcProperty, CentreArcsKeepTheProgrammedCentre) {
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> coord(-100, 100), ang(-kPi, kPi), rad(0.01, 80);
     for (int trial = 0; trial < 2000; ++trial) {
-        const Eigen::Vector2d c(coord(rng), coord(rng));
+        auto q9 = [](double v) { return std::stod(fmt::format("{:.9f}", v)); };
+        const Eigen::Vector2d c(q9(coord(rng)), q9(coord(rng)));
         const double r = rad(rng), a0 = ang(rng), a1 = ang(rng);
         ArcInput in;
         in.start = c + r * Eigen::Vector2d(std::cos(a0), std::sin(a0));
@@ -165,6 +169,82 @@ TEST(ArcProperty, CentreArcsKeepTheProgrammedCentre) {
         while (expect <= 0) expect += 2 * kPi;
         if ((in.end - in.start).norm() < 1e-9) expect = 2 * kPi;
         EXPECT_NEAR(out.sweep_rad, expect, 1e-6) << trial;
+    }
+}
+
+}  // namespace
+}  // namespace interp
+
+namespace interp {
+namespace {
+
+struct LastArc : CanonSink {
+    std::optional<canon::Arc> arc;
+    void emit(const Canon& c) override {
+        if (const auto* a = std::get_if<canon::Arc>(&c.cmd)) arc = *a;
+    }
+};
+
+// Arcs programmed under random rotations, uniform scalings and mirrors (all in G17) come out
+// with the start and end on one circle about the transformed programmed centre, and with the
+// direction flipped exactly when an odd number of plane mirrors is active.
+TEST(ArcProperty, ArcsThroughTheExecutorUnderRandomTransforms) {
+    std::mt19937 rng(2024);
+    std::uniform_real_distribution<double> coord(-50, 50), angle(-180, 180), fac(0.2, 3),
+        rad(1, 30), ang(-kPi, kPi);
+    std::uniform_int_distribution<int> kind(0, 2), coin(0, 1);
+    for (int trial = 0; trial < 300; ++trial) {
+        LastArc sink;
+        Executor exec(sink, BackendConfig{});
+        ProgramTransform ref;
+        int mirrors = 0;
+        auto run = [&](const std::string& line) { exec.execute(test::blk(line)); };
+        run("G01 F100");
+        // Values go through the program text, so the reference uses the printed values.
+        auto q = [](double v) { return std::stod(fmt::format("{:.6f}", v)); };
+        for (int k = 0; k < 3; ++k) {
+            const double cx = q(coord(rng)), cy = q(coord(rng));
+            switch (kind(rng)) {
+                case 0: {
+                    const double a = q(angle(rng));
+                    run(fmt::format("G68 X{:.6f} Y{:.6f} R{:.6f}", cx, cy, a));
+                    ref.push_rotation(Plane::XY, {cx, cy, 0}, a);
+                    break;
+                }
+                case 1: {
+                    const double f = q(fac(rng));
+                    run(fmt::format("G51 X{:.6f} Y{:.6f} P{:.6f}", cx, cy, f));
+                    ref.push_scale({cx, cy, 0}, {f, f, 1});
+                    break;
+                }
+                default:
+                    run(fmt::format("G51.1 X{:.6f}", cx));
+                    ref.push_mirror({cx, 0, 0}, 1);
+                    ++mirrors;
+            }
+        }
+        // A circle in program coordinates, start and end on it.
+        auto q9 = [](double v) { return std::stod(fmt::format("{:.9f}", v)); };
+        const Eigen::Vector2d c(q9(coord(rng)), q9(coord(rng)));
+        const double r = rad(rng), a0 = ang(rng), a1 = ang(rng);
+        Eigen::Vector2d s = c + r * Eigen::Vector2d(std::cos(a0), std::sin(a0));
+        Eigen::Vector2d e = c + r * Eigen::Vector2d(std::cos(a1), std::sin(a1));
+        s = {q9(s.x()), q9(s.y())};
+        e = {q9(e.x()), q9(e.y())};
+        const bool ccw = coin(rng) == 1;
+        run(fmt::format("G01 X{:.9f} Y{:.9f}", s.x(), s.y()));
+        const Eigen::Vector3d start = ref.apply({s.x(), s.y(), 0});
+        run(fmt::format("{} X{:.9f} Y{:.9f} I{:.9f} J{:.9f}", ccw ? "G03" : "G02", e.x(), e.y(),
+                        c.x() - s.x(), c.y() - s.y()));
+        ASSERT_TRUE(sink.arc) << trial;
+        const canon::Arc& a = *sink.arc;
+        const Eigen::Vector3d centre(a.centre_mm[0], a.centre_mm[1], a.centre_mm[2]);
+        const Eigen::Vector3d end(a.end_mm[0], a.end_mm[1], a.end_mm[2]);
+        EXPECT_NEAR((centre - ref.apply({c.x(), c.y(), 0})).norm(), 0, 1e-6) << trial;
+        EXPECT_NEAR((end - ref.apply({e.x(), e.y(), 0})).norm(), 0, 1e-6) << trial;
+        EXPECT_NEAR((start - centre).norm(), (end - centre).norm(), 1e-6) << trial;
+        EXPECT_EQ(a.turns > 0, ccw != (mirrors % 2 == 1)) << trial;
+        EXPECT_EQ(a.plane, Plane::XY);
     }
 }
 
