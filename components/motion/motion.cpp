@@ -1,0 +1,258 @@
+// motion: the trajectory controller. A non-realtime planner thread (program_feeder.cpp) runs a
+// G-code program through the interpreter and the look-ahead planner; the realtime function
+// `motion-controller` samples the planned trajectory once per servo period, applies overrides,
+// feed hold and abort, and writes LinuxCNC-named axis and joint pins.
+//
+// Kinematics inside this component are trivial (joint N follows the axis named by the N-th
+// letter of coordinates=); the kins_* components exist for other machines, wired externally
+// from the axis.L.pos-cmd pins.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "hal/component.hpp"
+#include "interp/dialect.hpp"
+#include "motion/kinematics.hpp"
+#include "motion/planner.hpp"
+#include "motion/sampler.hpp"
+#include "program_feeder.hpp"
+
+namespace {
+
+constexpr char kLowerAxes[] = "xyzabcuvw";
+constexpr char kUpperAxes[] = "XYZABCUVW";
+constexpr double kMaxOverride = 1.2;
+
+struct AxisPins {
+    int axis;  // index into motion::AxisArray
+    std::unique_ptr<hal::Out<double>> pos_cmd;
+    std::unique_ptr<hal::Param<double>> max_velocity;
+    std::unique_ptr<hal::Param<double>> max_acceleration;
+    std::unique_ptr<hal::Param<double>> max_jerk;
+};
+
+std::string upper(std::string s) {
+    for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    return s;
+}
+
+double clamp_override(double v) noexcept {
+    if (!(v > 0)) return 0;  // also NaN
+    return std::min(v, kMaxOverride);
+}
+
+class Motion : public hal::Instance {
+  public:
+    Motion()
+        : coordinates_(read_coordinates()),
+          kins_(coordinates_),
+          joint_count_(kins_.joint_count()),
+          motor_pos_cmd_(this, "joint.{}.motor-pos-cmd", joint_count_),
+          motor_pos_fb_(this, "joint.{}.motor-pos-fb", joint_count_),
+          f_error_(this, "joint.{}.f-error", joint_count_),
+          amp_enable_out_(this, "joint.{}.amp-enable-out", joint_count_),
+          ring_(ring_capacity()) {
+        check_num_joints();
+        program_path_ = arg("program").value_or("");
+        if (!program_path_.empty() && !std::ifstream(program_path_))
+            throw hal::Error(fmt::format("program={}: cannot open the file", program_path_));
+        dialect_ = arg("dialect").value_or("");
+        if (!dialect_.empty() && !interp::find_dialect(dialect_))
+            throw hal::Error(fmt::format("dialect={}: unknown dialect", dialect_));
+        const long period_ns = arg_int("servo_period_nsec", 1000000);
+        if (period_ns <= 0) throw hal::Error("servo_period_nsec must be > 0");
+        servo_period_s_ = static_cast<double>(period_ns) * 1e-9;
+        make_axis_pins();
+        joint_cmd_mm_.assign(joint_count_, 0.0);
+        shared_function<&Motion::update>("=motion-controller");
+    }
+
+    void start() override {
+        if (sampler_) return;  // planned once per load; a restart continues where it stopped
+        motion::PlannerConfig plan = planner_config();
+        try {
+            motion::validate(plan);
+        } catch (const std::invalid_argument& e) {
+            throw hal::Error(fmt::format("{}: {}", name(), e.what()));
+        }
+        sampler_ = std::make_unique<motion::Sampler>(motion::sampler_config(plan), ring_,
+                                                     motion::AxisArray{});
+        if (program_path_.empty()) return;
+        motioncomp::FeederConfig cfg;
+        cfg.program_path = program_path_;
+        cfg.dialect = dialect_;
+        cfg.plan = plan;
+        cfg.coordinates = coordinates_;
+        for (char c : coordinates_) cfg.axis_present[motion::axis_index(c)] = true;
+        cfg.blend_tolerance_mm = blend_tolerance_mm_;
+        feeder_ = std::make_unique<motioncomp::ProgramFeeder>(std::move(cfg), ring_);
+        feeder_->start_and_wait_ready();
+        // An error found before the first servo period is a configuration error: say so now,
+        // so `start` fails with the program's file:line instead of a half-run program and a
+        // fault pin. Nothing consumes the ring yet, so it can be emptied here; a later
+        // `start` plans the (perhaps corrected) file again.
+        if (feeder_->failed()) {
+            const std::string message = feeder_->error();
+            feeder_.reset();
+            sampler_.reset();
+            while (ring_.size() > 0) ring_.pop();
+            throw hal::Error(message);
+        }
+    }
+
+    void stop() override {
+        if (feeder_) feeder_->stop();
+    }
+
+    void update(hal::Period p) noexcept {
+        if (!sampler_) return;  // start() failed: nothing planned, nothing to command
+        const bool enabled = enable_;
+        const bool planner_failed = feeder_ && feeder_->failed();
+        const bool abort_now = abort_;
+        if (abort_now && !abort_seen_) {
+            sampler_->abort();
+            if (feeder_) feeder_->cancel();
+        }
+        if (!abort_now && abort_seen_) sampler_->clear_abort();
+        abort_seen_ = abort_now;
+
+        sampler_->set_feed_override(clamp_override(feed_override_));
+        sampler_->set_rapid_override(clamp_override(rapid_override_));
+        sampler_->set_hold(feed_hold_ || !enabled);
+        const motion::MotionSample s = sampler_->advance(p.s);
+        const motion::SamplerStatus& st = sampler_->status();
+
+        for (const AxisPins& a : axes_) *a.pos_cmd = s.pos_mm[a.axis];
+        kins_.inverse(s.pos_mm, joint_cmd_mm_);
+        for (std::size_t j = 0; j < joint_count_; ++j) {
+            motor_pos_cmd_[j] = joint_cmd_mm_[j];
+            f_error_[j] = joint_cmd_mm_[j] - motor_pos_fb_[j].get();
+            amp_enable_out_[j] = enabled && !planner_failed;
+        }
+        double v2 = 0;
+        for (double v : s.vel_mm_s) v2 += v * v;
+        current_vel_ = std::sqrt(v2);
+        program_line_ = s.line;
+        const bool planning = feeder_ && !feeder_->idle();
+        const bool queue_empty = st.done || ring_.size() == 0 || st.aborted;
+        in_position_ = !st.moving && queue_empty && !planning;
+        fault_ = planner_failed;
+        ignored_commands_ = feeder_ ? feeder_->ignored_commands() : 0u;
+    }
+
+  private:
+    std::string read_coordinates() const {
+        std::string c = upper(arg("coordinates").value_or(""));
+        if (c.empty()) {
+            const long n = arg_int("num_joints", 3);
+            if (n < 1 || n > motion::kAxes)
+                throw hal::Error(fmt::format("num_joints={}: must be 1 to {}", n, motion::kAxes));
+            c.assign(kUpperAxes, static_cast<std::size_t>(n));
+        }
+        for (char ch : c)
+            if (motion::axis_index(ch) < 0)
+                throw hal::Error(
+                    fmt::format("coordinates={}: '{}' is not an axis letter (XYZABCUVW)", c, ch));
+        return c;
+    }
+
+    std::size_t ring_capacity() const {
+        const long n = arg_int("queue", 4096);
+        if (n < 2 || n > (1L << 20))
+            throw hal::Error(fmt::format("queue={}: must be 2 to {} records", n, 1L << 20));
+        return static_cast<std::size_t>(n);
+    }
+
+    void check_num_joints() const {
+        const long n = arg_int("num_joints", static_cast<long>(joint_count_));
+        if (n != static_cast<long>(joint_count_))
+            throw hal::Error(fmt::format(
+                "num_joints={} does not match coordinates={} ({} joints, one per letter)", n,
+                coordinates_, joint_count_));
+    }
+
+    void make_axis_pins() {
+        for (int k = 0; k < motion::kAxes; ++k) {
+            if (coordinates_.find(kUpperAxes[k]) == std::string::npos) continue;
+            const std::string stem = fmt::format("axis.{}", kLowerAxes[k]);
+            AxisPins a;
+            a.axis = k;
+            a.pos_cmd = std::make_unique<hal::Out<double>>(this, stem + ".pos-cmd");
+            a.max_velocity =
+                std::make_unique<hal::Param<double>>(this, stem + ".max-velocity", 100.0);
+            a.max_acceleration =
+                std::make_unique<hal::Param<double>>(this, stem + ".max-acceleration", 1000.0);
+            a.max_jerk = std::make_unique<hal::Param<double>>(this, stem + ".max-jerk", 0.0);
+            axes_.push_back(std::move(a));
+        }
+    }
+
+    // Limits from the params at start(); axes the machine lacks get the loosest present
+    // limits so validate() passes (the feeder refuses moves on them anyway).
+    motion::PlannerConfig planner_config() const {
+        motion::PlannerConfig plan;
+        plan.servo_period_s = servo_period_s_;
+        plan.max_rate = kMaxOverride;
+        for (const AxisPins& a : axes_) {
+            plan.limits.vel_mm_s[a.axis] = a.max_velocity->get();
+            plan.limits.acc_mm_s2[a.axis] = a.max_acceleration->get();
+            plan.limits.jerk_mm_s3[a.axis] = a.max_jerk->get();
+        }
+        for (int k = 0; k < motion::kAxes; ++k) {
+            if (coordinates_.find(kUpperAxes[k]) != std::string::npos) continue;
+            plan.limits.vel_mm_s[k] = 1e9;
+            plan.limits.acc_mm_s2[k] = 1e9;
+            plan.limits.jerk_mm_s3[k] = 0;
+        }
+        for (const AxisPins& a : axes_) {
+            if (!(a.max_velocity->get() > 0) || !(a.max_acceleration->get() > 0) ||
+                !(a.max_jerk->get() >= 0))
+                throw hal::Error(fmt::format(
+                    "{}: axis.{}: max-velocity and max-acceleration must be > 0, max-jerk >= 0",
+                    name(), kLowerAxes[a.axis]));
+        }
+        return plan;
+    }
+
+    std::string coordinates_;
+    motion::TrivialKinematics kins_;
+    std::size_t joint_count_;
+
+    hal::Array<hal::Out<double>> motor_pos_cmd_;
+    hal::Array<hal::In<double>> motor_pos_fb_;
+    hal::Array<hal::Out<double>> f_error_;
+    hal::Array<hal::Out<bool>> amp_enable_out_;
+    std::vector<AxisPins> axes_;
+
+    hal::In<bool> enable_{this, "motion.enable"};
+    hal::In<bool> feed_hold_{this, "motion.feed-hold"};
+    hal::In<bool> abort_{this, "motion.abort"};
+    hal::In<double> feed_override_{this, "motion.feed-override", 1.0};
+    hal::In<double> rapid_override_{this, "motion.rapid-override", 1.0};
+    hal::Out<double> current_vel_{this, "motion.current-vel"};
+    hal::Out<std::int32_t> program_line_{this, "motion.program-line"};
+    hal::Out<bool> in_position_{this, "motion.in-position", true};
+    hal::Out<bool> fault_{this, "motion.fault"};
+    hal::Out<std::uint32_t> ignored_commands_{this, "motion.ignored-commands"};
+    hal::Param<double> blend_tolerance_mm_{this, "motion.blend-tolerance", 0.01};
+
+    motion::SpscRing<motion::PreparedSegment> ring_;
+    std::unique_ptr<motion::Sampler> sampler_;
+    std::unique_ptr<motioncomp::ProgramFeeder> feeder_;
+    std::string program_path_;
+    std::string dialect_;
+    double servo_period_s_ = 1e-3;
+    std::vector<double> joint_cmd_mm_;
+    bool abort_seen_ = false;
+};
+
+}  // namespace
+
+HAL_COMPONENT(motion, Motion, "Trajectory planner and servo-rate motion controller", "num_joints",
+              "coordinates", "program", "dialect", "servo_period_nsec", "queue")

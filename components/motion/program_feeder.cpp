@@ -1,0 +1,248 @@
+#include "program_feeder.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <functional>
+#include <stdexcept>
+#include <type_traits>
+#include <utility>
+#include <variant>
+
+#include "interp/canon.hpp"
+#include "interp/dialect.hpp"
+#include "interp/executor.hpp"
+#include "interp/interpreter.hpp"
+
+namespace motioncomp {
+
+namespace {
+
+constexpr char kAxisLetters[] = "XYZABCUVW";
+
+// The interpreter's machine axes (X Y Z A B C) are the first of the planner's nine.
+motion::AxisArray to_axes(const interp::AxisVec& v) {
+    motion::AxisArray out{};
+    for (int k = 0; k < interp::kMachineAxes && k < motion::kAxes; ++k) out[k] = v[k];
+    return out;
+}
+
+// Turns canonical commands into planner input. Commands without a motion meaning for this
+// component (spindle, coolant, I/O, tool changes, waits, messages) are counted, not obeyed.
+class PlanSink final : public interp::CanonSink {
+  public:
+    using Flush = std::function<void(bool)>;
+
+    PlanSink(motion::Planner& planner, const FeederConfig& cfg, std::atomic<std::uint32_t>& ignored,
+             Flush flush, std::function<void(const motion::PreparedSegment&)> push_dwell)
+        : planner_(planner),
+          cfg_(cfg),
+          ignored_(ignored),
+          flush_(std::move(flush)),
+          push_dwell_(std::move(push_dwell)),
+          pos_mm_(planner.end_position()) {}
+
+    void emit(const interp::Canon& c) override {
+        std::visit([&](const auto& cmd) { handle(c.loc, cmd); }, c.cmd);
+    }
+
+  private:
+    void handle(const interp::SourceLoc& loc, const interp::canon::Traverse& t) {
+        motion::PathSegment seg = base_segment(loc, t.end_mm);
+        seg.rapid = true;
+        push(loc, seg);
+    }
+    void handle(const interp::SourceLoc& loc, const interp::canon::FeedLine& f) {
+        motion::PathSegment seg = base_segment(loc, f.end_mm);
+        seg.feed_mm_s = feed_mm_s_;
+        push(loc, seg);
+    }
+    void handle(const interp::SourceLoc& loc, const interp::canon::Arc& a) {
+        motion::PathSegment seg = base_segment(loc, a.end_mm);
+        seg.kind = motion::SegmentKind::Arc;
+        const interp::PlaneAxes axes = interp::plane_axes(a.plane);
+        seg.plane_first = axes.first;
+        seg.plane_second = axes.second;
+        seg.plane_normal = axes.normal;
+        seg.centre_mm = {a.centre_mm[axes.first], a.centre_mm[axes.second]};
+        seg.turns = a.turns;
+        seg.feed_mm_s = feed_mm_s_;
+        push(loc, seg);
+    }
+    void handle(const interp::SourceLoc&, const interp::canon::SetFeedRate& f) {
+        feed_mm_s_ = f.feed_mm_s;
+    }
+    void handle(const interp::SourceLoc& loc, const interp::canon::Dwell& d) {
+        // The planner has no pause element: end the motion at rest, then queue a record that
+        // stands still for the dwell time.
+        planner_.finish();
+        flush_(true);
+        if (d.seconds > 0)
+            push_dwell_(dwell_record(pos_mm_, d.seconds, loc.line, cfg_.plan.max_rate));
+    }
+    void handle(const interp::SourceLoc&, const interp::canon::ProgramEnd&) {
+        planner_.finish();
+        flush_(true);
+    }
+    // Informational: end points already include offsets, units and plane are per move.
+    void handle(const interp::SourceLoc&, const interp::canon::Offsets&) {}
+    void handle(const interp::SourceLoc&, const interp::canon::ToolOffset&) {}
+    void handle(const interp::SourceLoc&, const interp::canon::Units&) {}
+    void handle(const interp::SourceLoc&, const interp::canon::SelectPlane&) {}
+    void handle(const interp::SourceLoc&, const interp::canon::SetFeedMode&) {}
+    template <class Other>
+    void handle(const interp::SourceLoc&, const Other&) {
+        ignored_.fetch_add(1, std::memory_order_relaxed);
+    }
+
+    motion::PathSegment base_segment(const interp::SourceLoc& loc, const interp::AxisVec& end) {
+        motion::PathSegment seg;
+        seg.end_mm = to_axes(end);
+        seg.tolerance_mm = cfg_.blend_tolerance_mm;
+        seg.line = loc.line;
+        for (int k = 0; k < motion::kAxes; ++k) {
+            if (!cfg_.axis_present[k] && std::fabs(seg.end_mm[k] - pos_mm_[k]) > 1e-9)
+                throw std::runtime_error(
+                    fmt::format("{}:{}:{}: axis {} moves but the machine has only coordinates={}",
+                                loc.file, loc.line, loc.col, kAxisLetters[k], cfg_.coordinates));
+        }
+        return seg;
+    }
+
+    void push(const interp::SourceLoc& loc, const motion::PathSegment& seg) {
+        try {
+            planner_.push(seg);
+        } catch (const motion::PlanError& e) {
+            // PlanError says "line N: reason"; the user needs the file too.
+            std::string reason = e.what();
+            const auto colon = reason.find(": ");
+            if (colon != std::string::npos) reason.erase(0, colon + 2);
+            throw std::runtime_error(
+                fmt::format("{}:{}:{}: {}", loc.file, loc.line, loc.col, reason));
+        }
+        pos_mm_ = seg.end_mm;
+        flush_(false);
+    }
+
+    motion::Planner& planner_;
+    const FeederConfig& cfg_;
+    std::atomic<std::uint32_t>& ignored_;
+    Flush flush_;
+    std::function<void(const motion::PreparedSegment&)> push_dwell_;
+    motion::AxisArray pos_mm_;
+    double feed_mm_s_ = 0;
+};
+
+}  // namespace
+
+motion::PreparedSegment dwell_record(const motion::AxisArray& pos_mm, double seconds,
+                                     std::int32_t line, double max_rate) {
+    motion::PreparedSegment rec{};
+    rec.geom = motion::make_line(pos_mm, pos_mm);
+    rec.profile.count = 1;  // one phase at rest: s = 0 throughout
+    rec.profile.duration_s = seconds;
+    rec.phase_rate_cap.fill(max_rate);  // nothing moves, so no rate can exceed a limit
+    rec.line = line;
+    rec.program_end = true;
+    return rec;
+}
+
+ProgramFeeder::ProgramFeeder(FeederConfig cfg, motion::SpscRing<motion::PreparedSegment>& ring)
+    : cfg_(std::move(cfg)), ring_(ring) {}
+
+ProgramFeeder::~ProgramFeeder() {
+    stop();
+}
+
+void ProgramFeeder::start_and_wait_ready() {
+    if (thread_.joinable()) return;
+    thread_ = std::thread([this] { run(); });
+    std::unique_lock lock(mutex_);
+    ready_cv_.wait(lock, [this] { return ready_; });
+}
+
+void ProgramFeeder::stop() {
+    cancel_.store(true, std::memory_order_relaxed);
+    if (thread_.joinable()) thread_.join();
+}
+
+std::string ProgramFeeder::error() const {
+    std::lock_guard lock(mutex_);
+    return error_;
+}
+
+void ProgramFeeder::mark_ready() {
+    std::lock_guard lock(mutex_);
+    if (ready_) return;
+    ready_ = true;
+    ready_cv_.notify_all();
+}
+
+bool ProgramFeeder::flush(motion::Planner& planner, bool block) {
+    for (;;) {
+        if (!have_pending_) {
+            if (!planner.pop(pending_)) return true;
+            have_pending_ = true;
+        }
+        if (ring_.try_push(pending_)) {
+            have_pending_ = false;
+            continue;
+        }
+        // The ring is full: the servo side has a full lead, so start() may return now.
+        mark_ready();
+        if (!block || cancel_.load(std::memory_order_relaxed)) return false;
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+}
+
+void ProgramFeeder::plan_program() {
+    motion::Planner planner(cfg_.plan, motion::AxisArray{});
+    auto flush_fn = [&](bool block) {
+        if (!flush(planner, block) && cancel_.load(std::memory_order_relaxed))
+            throw std::runtime_error("");  // cancelled: unwinds the interpreter quietly
+    };
+    auto push_dwell = [&](const motion::PreparedSegment& rec) {
+        pending_ = rec;
+        have_pending_ = true;
+        flush_fn(true);
+    };
+    PlanSink sink(planner, cfg_, ignored_, flush_fn, push_dwell);
+    interp::BackendConfig backend;
+    interp::InterpreterOptions options;
+    options.main_m99_loops = false;  // a looping program would plan forever
+    if (!cfg_.dialect.empty()) options.dialect = interp::find_dialect(cfg_.dialect);
+    interp::Executor executor(sink, backend);
+    interp::Interpreter interpreter(executor, executor, options);
+    interpreter.open(cfg_.program_path);
+    try {
+        while (!cancel_.load(std::memory_order_relaxed) && interpreter.step()) {
+        }
+    } catch (...) {
+        // Motion already planned stays valid: let it run out to rest, then report.
+        planner.finish();
+        flush(planner, true);
+        throw;
+    }
+    planner.finish();
+    flush(planner, true);
+}
+
+void ProgramFeeder::run() noexcept {
+    try {
+        plan_program();
+    } catch (const std::exception& e) {
+        if (!cancel_.load(std::memory_order_relaxed)) {
+            {
+                std::lock_guard lock(mutex_);
+                error_ = e.what();
+            }
+            failed_.store(true, std::memory_order_release);
+        }
+    }
+    idle_.store(true, std::memory_order_release);
+    mark_ready();
+}
+
+}  // namespace motioncomp
