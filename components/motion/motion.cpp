@@ -68,13 +68,17 @@ class Motion : public hal::Instance {
         const long period_ns = arg_int("servo_period_nsec", 1000000);
         if (period_ns <= 0) throw hal::Error("servo_period_nsec must be > 0");
         servo_period_s_ = static_cast<double>(period_ns) * 1e-9;
+        lockstep_ = arg_int("sim_lockstep", 0) != 0;
         make_axis_pins();
         joint_cmd_mm_.assign(joint_count_, 0.0);
         shared_function<&Motion::update>("=motion-controller");
     }
 
     void start() override {
-        if (sampler_) return;  // planned once per load; a restart continues where it stopped
+        if (sampler_) {  // a restart after stop: planning continues where it paused
+            if (feeder_) feeder_->start_and_wait_ready();
+            return;
+        }
         motion::PlannerConfig plan = planner_config();
         try {
             motion::validate(plan);
@@ -117,11 +121,12 @@ class Motion : public hal::Instance {
         const bool abort_now = abort_;
         if (abort_now && !abort_seen_) {
             sampler_->abort();
-            if (feeder_) feeder_->cancel();
+            if (feeder_) feeder_->abandon();
         }
         if (!abort_now && abort_seen_) sampler_->clear_abort();
         abort_seen_ = abort_now;
 
+        if (lockstep_ && feeder_ && !abort_now) feeder_->wait_for_lead();
         sampler_->set_feed_override(clamp_override(feed_override_));
         sampler_->set_rapid_override(clamp_override(rapid_override_));
         sampler_->set_hold(feed_hold_ || !enabled);
@@ -133,7 +138,7 @@ class Motion : public hal::Instance {
         for (std::size_t j = 0; j < joint_count_; ++j) {
             motor_pos_cmd_[j] = joint_cmd_mm_[j];
             f_error_[j] = joint_cmd_mm_[j] - motor_pos_fb_[j].get();
-            amp_enable_out_[j] = enabled && !planner_failed;
+            amp_enable_out_[j] = enabled;
         }
         double v2 = 0;
         for (double v : s.vel_mm_s) v2 += v * v;
@@ -250,9 +255,10 @@ class Motion : public hal::Instance {
     double servo_period_s_ = 1e-3;
     std::vector<double> joint_cmd_mm_;
     bool abort_seen_ = false;
+    bool lockstep_ = false;  // wait for the planner each period (simulated clock only)
 };
 
 }  // namespace
 
 HAL_COMPONENT(motion, Motion, "Trajectory planner and servo-rate motion controller", "num_joints",
-              "coordinates", "program", "dialect", "servo_period_nsec", "queue")
+              "coordinates", "program", "dialect", "servo_period_nsec", "queue", "sim_lockstep")

@@ -5,7 +5,6 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
-#include <functional>
 #include <stdexcept>
 #include <type_traits>
 #include <utility>
@@ -33,16 +32,8 @@ motion::AxisArray to_axes(const interp::AxisVec& v) {
 // component (spindle, coolant, I/O, tool changes, waits, messages) are counted, not obeyed.
 class PlanSink final : public interp::CanonSink {
   public:
-    using Flush = std::function<void(bool)>;
-
-    PlanSink(motion::Planner& planner, const FeederConfig& cfg, std::atomic<std::uint32_t>& ignored,
-             Flush flush, std::function<void(const motion::PreparedSegment&)> push_dwell)
-        : planner_(planner),
-          cfg_(cfg),
-          ignored_(ignored),
-          flush_(std::move(flush)),
-          push_dwell_(std::move(push_dwell)),
-          pos_mm_(planner.end_position()) {}
+    PlanSink(motion::Planner& planner, const FeederConfig& cfg, ProgramFeeder& feeder)
+        : planner_(planner), cfg_(cfg), feeder_(feeder), pos_mm_(planner.end_position()) {}
 
     void emit(const interp::Canon& c) override {
         std::visit([&](const auto& cmd) { handle(c.loc, cmd); }, c.cmd);
@@ -78,13 +69,17 @@ class PlanSink final : public interp::CanonSink {
         // The planner has no pause element: end the motion at rest, then queue a record that
         // stands still for the dwell time.
         planner_.finish();
-        flush_(true);
-        if (d.seconds > 0)
-            push_dwell_(dwell_record(pos_mm_, d.seconds, loc.line, cfg_.plan.max_rate));
+        if (d.seconds > 0) {
+            const motion::PreparedSegment rec =
+                dwell_record(pos_mm_, d.seconds, loc.line, cfg_.plan.max_rate);
+            feeder_.collect(&rec);
+        } else {
+            feeder_.collect();
+        }
     }
     void handle(const interp::SourceLoc&, const interp::canon::ProgramEnd&) {
         planner_.finish();
-        flush_(true);
+        feeder_.collect();
     }
     // Informational: end points already include offsets, units and plane are per move.
     void handle(const interp::SourceLoc&, const interp::canon::Offsets&) {}
@@ -94,7 +89,7 @@ class PlanSink final : public interp::CanonSink {
     void handle(const interp::SourceLoc&, const interp::canon::SetFeedMode&) {}
     template <class Other>
     void handle(const interp::SourceLoc&, const Other&) {
-        ignored_.fetch_add(1, std::memory_order_relaxed);
+        feeder_.count_ignored();
     }
 
     motion::PathSegment base_segment(const interp::SourceLoc& loc, const interp::AxisVec& end) {
@@ -123,14 +118,12 @@ class PlanSink final : public interp::CanonSink {
                 fmt::format("{}:{}:{}: {}", loc.file, loc.line, loc.col, reason));
         }
         pos_mm_ = seg.end_mm;
-        flush_(false);
+        feeder_.collect();
     }
 
     motion::Planner& planner_;
     const FeederConfig& cfg_;
-    std::atomic<std::uint32_t>& ignored_;
-    Flush flush_;
-    std::function<void(const motion::PreparedSegment&)> push_dwell_;
+    ProgramFeeder& feeder_;
     motion::AxisArray pos_mm_;
     double feed_mm_s_ = 0;
 };
@@ -157,15 +150,25 @@ ProgramFeeder::~ProgramFeeder() {
 }
 
 void ProgramFeeder::start_and_wait_ready() {
-    if (thread_.joinable()) return;
+    if (thread_.joinable() || idle()) return;
+    pause_.store(false, std::memory_order_relaxed);
+    {
+        std::lock_guard lock(mutex_);
+        ready_ = false;
+    }
     thread_ = std::thread([this] { run(); });
     std::unique_lock lock(mutex_);
     ready_cv_.wait(lock, [this] { return ready_; });
 }
 
 void ProgramFeeder::stop() {
-    cancel_.store(true, std::memory_order_relaxed);
+    pause_.store(true, std::memory_order_relaxed);
     if (thread_.joinable()) thread_.join();
+}
+
+void ProgramFeeder::wait_for_lead() const noexcept {
+    while (!idle() && !abandoned_.load(std::memory_order_relaxed) && ring_.free_slots() > 0)
+        std::this_thread::yield();
 }
 
 std::string ProgramFeeder::error() const {
@@ -180,68 +183,76 @@ void ProgramFeeder::mark_ready() {
     ready_cv_.notify_all();
 }
 
-bool ProgramFeeder::flush(motion::Planner& planner, bool block) {
-    for (;;) {
-        if (!have_pending_) {
-            if (!planner.pop(pending_)) return true;
-            have_pending_ = true;
-        }
-        if (ring_.try_push(pending_)) {
-            have_pending_ = false;
-            continue;
-        }
-        // The ring is full: the servo side has a full lead, so start() may return now.
-        mark_ready();
-        if (!block || cancel_.load(std::memory_order_relaxed)) return false;
-        std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    }
+bool ProgramFeeder::stopping() const noexcept {
+    return pause_.load(std::memory_order_relaxed) || abandoned_.load(std::memory_order_relaxed);
 }
 
-void ProgramFeeder::plan_program() {
-    motion::Planner planner(cfg_.plan, motion::AxisArray{});
-    auto flush_fn = [&](bool block) {
-        if (!flush(planner, block) && cancel_.load(std::memory_order_relaxed))
-            throw std::runtime_error("");  // cancelled: unwinds the interpreter quietly
-    };
-    auto push_dwell = [&](const motion::PreparedSegment& rec) {
-        pending_ = rec;
-        have_pending_ = true;
-        flush_fn(true);
-    };
-    PlanSink sink(planner, cfg_, ignored_, flush_fn, push_dwell);
-    interp::BackendConfig backend;
+void ProgramFeeder::collect(const motion::PreparedSegment* extra) {
+    motion::PreparedSegment rec;
+    while (planner_->pop(rec)) outbox_.push_back(rec);
+    if (extra) outbox_.push_back(*extra);
+}
+
+void ProgramFeeder::deliver() noexcept {
+    while (!outbox_.empty() && ring_.try_push(outbox_.front())) outbox_.pop_front();
+}
+
+void ProgramFeeder::fail(const std::string& message) {
+    {
+        std::lock_guard lock(mutex_);
+        error_ = message;
+    }
+    failed_.store(true, std::memory_order_release);
+    // Motion already planned stays valid: it runs out to rest.
+    planner_->finish();
+    collect();
+    program_done_ = true;
+}
+
+void ProgramFeeder::open_program() {
+    planner_ = std::make_unique<motion::Planner>(cfg_.plan, motion::AxisArray{});
+    sink_ = std::make_unique<PlanSink>(*planner_, cfg_, *this);
     interp::InterpreterOptions options;
     options.main_m99_loops = false;  // a looping program would plan forever
     if (!cfg_.dialect.empty()) options.dialect = interp::find_dialect(cfg_.dialect);
-    interp::Executor executor(sink, backend);
-    interp::Interpreter interpreter(executor, executor, options);
-    interpreter.open(cfg_.program_path);
-    try {
-        while (!cancel_.load(std::memory_order_relaxed) && interpreter.step()) {
-        }
-    } catch (...) {
-        // Motion already planned stays valid: let it run out to rest, then report.
-        planner.finish();
-        flush(planner, true);
-        throw;
-    }
-    planner.finish();
-    flush(planner, true);
+    executor_ = std::make_unique<interp::Executor>(*sink_, interp::BackendConfig{});
+    interpreter_ = std::make_unique<interp::Interpreter>(*executor_, *executor_, options);
+    interpreter_->open(cfg_.program_path);
 }
 
 void ProgramFeeder::run() noexcept {
-    try {
-        plan_program();
-    } catch (const std::exception& e) {
-        if (!cancel_.load(std::memory_order_relaxed)) {
-            {
-                std::lock_guard lock(mutex_);
-                error_ = e.what();
-            }
-            failed_.store(true, std::memory_order_release);
+    // Interpreting runs ahead of the ring by at most this many records; more would only
+    // cost memory, since the servo side cannot use them before the ring has room.
+    constexpr std::size_t kOutboxLimit = 256;
+    if (!planner_) {
+        try {
+            open_program();
+        } catch (const std::exception& e) {
+            if (!planner_)
+                planner_ = std::make_unique<motion::Planner>(cfg_.plan, motion::AxisArray{});
+            fail(e.what());
         }
     }
-    idle_.store(true, std::memory_order_release);
+    while (!stopping()) {
+        deliver();
+        if (ring_.free_slots() == 0) mark_ready();  // a full lead: start() may return
+        if (program_done_ && outbox_.empty()) break;
+        if (program_done_ || outbox_.size() >= kOutboxLimit) {
+            std::this_thread::sleep_for(std::chrono::microseconds(200));
+            continue;
+        }
+        try {
+            if (!interpreter_->step()) {
+                planner_->finish();
+                collect();
+                program_done_ = true;
+            }
+        } catch (const std::exception& e) {
+            fail(e.what());
+        }
+    }
+    if ((program_done_ && outbox_.empty()) || abandoned_.load(std::memory_order_relaxed))
+        idle_.store(true, std::memory_order_release);
     mark_ready();
 }
 

@@ -7,6 +7,8 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <deque>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -14,6 +16,12 @@
 #include "motion/planner.hpp"
 #include "motion/prepared.hpp"
 #include "motion/spsc_ring.hpp"
+
+namespace interp {
+class Executor;
+class Interpreter;
+class CanonSink;
+}  // namespace interp
 
 namespace motioncomp {
 
@@ -33,16 +41,19 @@ class ProgramFeeder {
     ProgramFeeder(const ProgramFeeder&) = delete;
     ProgramFeeder& operator=(const ProgramFeeder&) = delete;
 
-    // Configuration world. Starts the thread and blocks until the whole program is planned
-    // and in the ring, the ring is full, or the program failed. This is what makes a
-    // simulated-clock run deterministic: the servo function never sees a half-planned queue
-    // unless the program is longer than the ring.
+    // Configuration world. Starts (or resumes, after stop()) the thread and blocks until the
+    // whole program is planned and in the ring, the ring is full, or the program failed. This
+    // is what makes a simulated-clock run deterministic: the servo function never sees a
+    // half-planned queue unless the program is longer than the ring.
     void start_and_wait_ready();
-    // Configuration world: cancels planning and joins the thread.
+    // Configuration world: pauses planning (joins the thread); start_and_wait_ready() resumes.
     void stop();
 
-    // Realtime-safe: asks the thread to stop feeding (abort).
-    void cancel() noexcept { cancel_.store(true, std::memory_order_relaxed); }
+    // Realtime-safe: gives the rest of the program up for good (abort).
+    void abandon() noexcept { abandoned_.store(true, std::memory_order_relaxed); }
+    // Spins until the ring is full or nothing more will come. Not realtime-safe: only for the
+    // opt-in lock-step mode of simulated-clock runs (see docs/components/motion.md).
+    void wait_for_lead() const noexcept;
 
     // Realtime-safe status.
     bool idle() const noexcept { return idle_.load(std::memory_order_acquire); }
@@ -50,24 +61,36 @@ class ProgramFeeder {
     std::uint32_t ignored_commands() const noexcept {
         return ignored_.load(std::memory_order_relaxed);
     }
-    // Configuration world, valid once failed() is true: "file:line[:col]: reason".
+    // Configuration world, valid once failed() is true: "file:line:col: reason".
     std::string error() const;
+
+    // Used by the canonical-command sink, on the feeder thread.
+    void count_ignored() noexcept { ignored_.fetch_add(1, std::memory_order_relaxed); }
+    // Moves the planner's finished records to the outbox, then appends `extra` if given.
+    void collect(const motion::PreparedSegment* extra = nullptr);
 
   private:
     void run() noexcept;
-    void plan_program();
-    // Moves planned records into the ring; waits for room unless `block` is false or
-    // planning was cancelled. Returns false if it gave up with records still pending.
-    bool flush(motion::Planner& planner, bool block);
+    void open_program();
+    bool stopping() const noexcept;
+    void deliver() noexcept;  // outbox -> ring, as far as it fits
+    void fail(const std::string& message);
     void mark_ready();
 
     FeederConfig cfg_;
     motion::SpscRing<motion::PreparedSegment>& ring_;
-    motion::PreparedSegment pending_{};
-    bool have_pending_ = false;
+
+    // Planning state: kept across stop()/start so a paused program continues where it was.
+    std::unique_ptr<motion::Planner> planner_;
+    std::unique_ptr<interp::CanonSink> sink_;
+    std::unique_ptr<interp::Executor> executor_;
+    std::unique_ptr<interp::Interpreter> interpreter_;
+    std::deque<motion::PreparedSegment> outbox_;  // planned, in order, not yet in the ring
+    bool program_done_ = false;                   // interpreter ended (or failed), planner finished
 
     std::thread thread_;
-    std::atomic<bool> cancel_{false};
+    std::atomic<bool> pause_{false};
+    std::atomic<bool> abandoned_{false};
     std::atomic<bool> idle_{false};
     std::atomic<bool> failed_{false};
     std::atomic<std::uint32_t> ignored_{0};
