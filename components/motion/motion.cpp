@@ -148,6 +148,7 @@ class Motion : public hal::Instance {
         const bool queue_empty = st.done || ring_.size() == 0 || st.aborted;
         in_position_ = !st.moving && queue_empty && !planning;
         fault_ = planner_failed;
+        if (st.starved) starved_periods_ = ++starved_count_;
         ignored_commands_ = feeder_ ? feeder_->ignored_commands() : 0u;
     }
 
@@ -245,6 +246,7 @@ class Motion : public hal::Instance {
     hal::Out<bool> in_position_{this, "motion.in-position", true};
     hal::Out<bool> fault_{this, "motion.fault"};
     hal::Out<std::uint32_t> ignored_commands_{this, "motion.ignored-commands"};
+    hal::Out<std::uint32_t> starved_periods_{this, "motion.starved-periods"};
     hal::Param<double> blend_tolerance_mm_{this, "motion.blend-tolerance", 0.01};
 
     motion::SpscRing<motion::PreparedSegment> ring_;
@@ -255,6 +257,7 @@ class Motion : public hal::Instance {
     double servo_period_s_ = 1e-3;
     std::vector<double> joint_cmd_mm_;
     bool abort_seen_ = false;
+    std::uint32_t starved_count_ = 0;
     bool lockstep_ = false;  // wait for the planner each period (simulated clock only)
 };
 
