@@ -96,12 +96,12 @@ class Motion : public hal::Instance {
         for (char c : coordinates_) cfg.axis_present[motion::axis_index(c)] = true;
         cfg.blend_tolerance_mm = blend_tolerance_mm_;
         feeder_ = std::make_unique<motioncomp::ProgramFeeder>(std::move(cfg), ring_);
-        feeder_->start_and_wait_ready();
+        const bool failed_early = feeder_->start_and_wait_ready();
         // An error found before the first servo period is a configuration error: say so now,
         // so `start` fails with the program's file:line instead of a half-run program and a
         // fault pin. Nothing consumes the ring yet, so it can be emptied here; a later
         // `start` plans the (perhaps corrected) file again.
-        if (feeder_->failed()) {
+        if (failed_early) {
             const std::string message = feeder_->error();
             feeder_.reset();
             sampler_.reset();
@@ -111,7 +111,15 @@ class Motion : public hal::Instance {
     }
 
     void stop() override {
-        if (feeder_) feeder_->stop();
+        if (!feeder_) return;
+        feeder_->stop();
+        report_late_error();
+    }
+
+    ~Motion() override {
+        if (!feeder_) return;
+        feeder_->stop();
+        report_late_error();
     }
 
     void update(hal::Period p) noexcept {
@@ -153,6 +161,14 @@ class Motion : public hal::Instance {
     }
 
   private:
+    // An error met while the program was already running has only the fault pin in realtime;
+    // the text is printed here, in the configuration world, once.
+    void report_late_error() {
+        if (error_reported_ || !feeder_->failed()) return;
+        error_reported_ = true;
+        fmt::print(stderr, "{}: {}\n", name(), feeder_->error());
+    }
+
     std::string read_coordinates() const {
         std::string c = upper(arg("coordinates").value_or(""));
         if (c.empty()) {
@@ -258,7 +274,8 @@ class Motion : public hal::Instance {
     std::vector<double> joint_cmd_mm_;
     bool abort_seen_ = false;
     std::uint32_t starved_count_ = 0;
-    bool lockstep_ = false;  // wait for the planner each period (simulated clock only)
+    bool lockstep_ = false;
+    bool error_reported_ = false;  // wait for the planner each period (simulated clock only)
 };
 
 }  // namespace

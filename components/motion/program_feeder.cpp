@@ -149,8 +149,8 @@ ProgramFeeder::~ProgramFeeder() {
     stop();
 }
 
-void ProgramFeeder::start_and_wait_ready() {
-    if (thread_.joinable() || idle()) return;
+bool ProgramFeeder::start_and_wait_ready() {
+    if (thread_.joinable() || idle()) return false;
     pause_.store(false, std::memory_order_relaxed);
     {
         std::lock_guard lock(mutex_);
@@ -159,6 +159,7 @@ void ProgramFeeder::start_and_wait_ready() {
     thread_ = std::thread([this] { run(); });
     std::unique_lock lock(mutex_);
     ready_cv_.wait(lock, [this] { return ready_; });
+    return failed_at_ready_;
 }
 
 void ProgramFeeder::stop() {
@@ -180,6 +181,7 @@ void ProgramFeeder::mark_ready() {
     std::lock_guard lock(mutex_);
     if (ready_) return;
     ready_ = true;
+    failed_at_ready_ = failed();
     ready_cv_.notify_all();
 }
 

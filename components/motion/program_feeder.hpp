@@ -44,8 +44,10 @@ class ProgramFeeder {
     // Configuration world. Starts (or resumes, after stop()) the thread and blocks until the
     // whole program is planned and in the ring, the ring is full, or the program failed. This
     // is what makes a simulated-clock run deterministic: the servo function never sees a
-    // half-planned queue unless the program is longer than the ring.
-    void start_and_wait_ready();
+    // half-planned queue unless the program is longer than the ring. Returns true if the
+    // program had failed by then (decided at that moment, so the answer does not depend on
+    // how far the thread gets before the caller looks).
+    bool start_and_wait_ready();
     // Configuration world: pauses planning (joins the thread); start_and_wait_ready() resumes.
     void stop();
 
@@ -98,6 +100,7 @@ class ProgramFeeder {
     mutable std::mutex mutex_;
     std::condition_variable ready_cv_;
     bool ready_ = false;
+    bool failed_at_ready_ = false;
     std::string error_;
 };
 
