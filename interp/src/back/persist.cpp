@@ -185,8 +185,8 @@ void save_settings_atomic(const std::string& path, const Settings& s) {
         sys_fail("cannot replace settings file", path);
     }
     // The rename itself must reach the disk, or a crash could bring back the old name.
-    std::string dir = std::filesystem::path(path).parent_path().string();
-    if (dir.empty()) dir = ".";
+    const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+    const std::filesystem::path dir = parent.empty() ? std::filesystem::path(".") : parent;
     int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (dfd >= 0) {
         ::fsync(dfd);
