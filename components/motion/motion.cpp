@@ -124,17 +124,13 @@ class Motion : public hal::Instance {
 
     void update(hal::Period p) noexcept {
         if (!sampler_) return;  // start() failed: nothing planned, nothing to command
-        const bool enabled = enable_;
-        const bool planner_failed = feeder_ && feeder_->failed();
-        const bool abort_now = abort_;
-        if (abort_now && !abort_seen_) {
-            sampler_->abort();
-            if (feeder_) feeder_->abandon();
-        }
-        if (!abort_now && abort_seen_) sampler_->clear_abort();
-        abort_seen_ = abort_now;
+        const bool enable = enable_;
+        if (enable && !enable_seen_) drive_fault_ = false;  // re-enabling clears a drive fault
+        enable_seen_ = enable;
+        apply_abort(abort_ || drive_fault_);
+        const bool enabled = enable && !drive_fault_;
 
-        if (lockstep_ && feeder_ && !abort_now) feeder_->wait_for_lead();
+        if (lockstep_ && feeder_ && !abort_seen_) feeder_->wait_for_lead();
         sampler_->set_feed_override(clamp_override(feed_override_));
         sampler_->set_rapid_override(clamp_override(rapid_override_));
         sampler_->set_hold(feed_hold_ || !enabled);
@@ -143,10 +139,9 @@ class Motion : public hal::Instance {
 
         for (const AxisPins& a : axes_) *a.pos_cmd = s.pos_mm[a.axis];
         kins_.inverse(s.pos_mm, joint_cmd_mm_);
-        for (std::size_t j = 0; j < joint_count_; ++j) {
-            motor_pos_cmd_[j] = joint_cmd_mm_[j];
-            f_error_[j] = joint_cmd_mm_[j] - motor_pos_fb_[j].get();
-            amp_enable_out_[j] = enabled;
+        if (write_joints(enabled) && !drive_fault_) {
+            drive_fault_ = true;  // the stop ramp starts next period; amps drop now
+            for (std::size_t j = 0; j < joint_count_; ++j) amp_enable_out_[j] = false;
         }
         double v2 = 0;
         for (double v : s.vel_mm_s) v2 += v * v;
@@ -155,12 +150,41 @@ class Motion : public hal::Instance {
         const bool planning = feeder_ && !feeder_->idle();
         const bool queue_empty = st.done || ring_.size() == 0 || st.aborted;
         in_position_ = !st.moving && queue_empty && !planning;
-        fault_ = planner_failed;
+        fault_ = drive_fault_ || (feeder_ && feeder_->failed());
         if (st.starved) starved_periods_ = ++starved_count_;
         ignored_commands_ = feeder_ ? feeder_->ignored_commands() : 0u;
     }
 
   private:
+    // Abort on a rising edge: a controlled stop, and the rest of the program is given up.
+    void apply_abort(bool request) noexcept {
+        if (request && !abort_seen_) {
+            sampler_->abort();
+            if (feeder_) feeder_->abandon();
+        }
+        if (!request && abort_seen_) sampler_->clear_abort();
+        abort_seen_ = request;
+    }
+
+    // Joint commands, following errors and amp enables; true if a drive reports a fault or a
+    // following error exceeds its limit while enabled.
+    bool write_joints(bool enabled) noexcept {
+        bool fault = false;
+        for (std::size_t j = 0; j < joint_count_; ++j) {
+            motor_pos_cmd_[j] = joint_cmd_mm_[j];
+            const double ferror = joint_cmd_mm_[j] - motor_pos_fb_[j].get();
+            const double limit = max_ferror_[j].get();
+            const bool errored = limit > 0 && std::fabs(ferror) > limit;
+            f_error_[j] = ferror;
+            f_error_lim_[j] = limit;
+            f_errored_[j] = errored;
+            amp_enable_out_[j] = enabled;
+            // A disabled machine may sit anywhere: only an enabled one trips.
+            fault = fault || (enabled && (errored || amp_fault_in_[j].get()));
+        }
+        return fault;
+    }
+
     // An error met while the program was already running has only the fault pin in realtime;
     // the text is printed here, in the configuration world, once.
     void report_late_error() {
@@ -250,6 +274,10 @@ class Motion : public hal::Instance {
     hal::Array<hal::In<double>> motor_pos_fb_;
     hal::Array<hal::Out<double>> f_error_;
     hal::Array<hal::Out<bool>> amp_enable_out_;
+    hal::Array<hal::In<bool>> amp_fault_in_{this, "joint.{}.amp-fault-in", joint_count_};
+    hal::Array<hal::Out<double>> f_error_lim_{this, "joint.{}.f-error-lim", joint_count_};
+    hal::Array<hal::Out<bool>> f_errored_{this, "joint.{}.f-errored", joint_count_};
+    hal::Array<hal::Param<double>> max_ferror_{this, "joint.{}.max-ferror", joint_count_};
     std::vector<AxisPins> axes_;
 
     hal::In<bool> enable_{this, "motion.enable"};
@@ -273,6 +301,8 @@ class Motion : public hal::Instance {
     double servo_period_s_ = 1e-3;
     std::vector<double> joint_cmd_mm_;
     bool abort_seen_ = false;
+    bool enable_seen_ = false;
+    bool drive_fault_ = false;  // latched until motion.enable rises again
     std::uint32_t starved_count_ = 0;
     bool lockstep_ = false;
     bool error_reported_ = false;  // wait for the planner each period (simulated clock only)
