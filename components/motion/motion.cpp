@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <memory>
@@ -263,6 +264,8 @@ class Motion : public hal::Instance {
                     "{}: axis.{}: max-velocity and max-acceleration must be > 0, max-jerk >= 0",
                     name(), kLowerAxes[a.axis]));
         }
+        if (!(blend_tolerance_mm_.get() >= 0))
+            throw hal::Error(fmt::format("{}: motion.blend-tolerance must be >= 0 mm", name()));
         return plan;
     }
 
