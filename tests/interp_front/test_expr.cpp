@@ -223,6 +223,31 @@ TEST_F(ExprFixture, ErrorUnconfiguredSetting) {
               "e.nc:3:1: named parameter #SAFEHEIGHT is not configured on this machine");
 }
 
+// The per-block undo log: every write of a rejected block is undone, newest first, including
+// "was never set".
+TEST(Variables, RollbackRestoresValuesAndUnsetState) {
+    Variables v;
+    v.set_numbered(1, 10, {});
+    v.set_fixed_cycle(5, 3, {});
+    v.begin();
+    v.set_numbered(1, 20, {});
+    v.set_numbered(1, 30, {});
+    v.set_numbered(2, 40, {});
+    v.set_fixed_cycle(5, 9, {});
+    v.rollback();
+    EXPECT_EQ(*v.numbered_if_set(1), 10.0);
+    EXPECT_FALSE(v.numbered_if_set(2));
+    EXPECT_EQ(v.fixed_cycle(5, {}), 3.0);
+    v.begin();
+    v.set_numbered(2, 7, {});
+    v.commit();
+    v.rollback();  // nothing left to undo after a commit
+    EXPECT_EQ(*v.numbered_if_set(2), 7.0);
+    v.clear();
+    EXPECT_FALSE(v.numbered_if_set(1));
+    EXPECT_EQ(v.fixed_cycle(5, {}), 0.0);
+}
+
 TEST(ToInteger, RoundsNearAndRejectsFractions) {
     EXPECT_EQ(to_integer(2.9999999, {}, "L"), 3);
     EXPECT_EQ(to_integer(-4.0000001, {}, "L"), -4);
