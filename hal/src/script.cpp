@@ -227,6 +227,11 @@ void Script::cmd_loadusr(const std::vector<std::string>& words) {
     pid_t pid = ::fork();
     if (pid < 0) throw Error(fmt::format("loadusr: fork failed: {}", std::strerror(errno)));
     if (pid == 0) {
+        // halrun blocks SIGINT/SIGTERM in its threads to take them in one place; a child must
+        // not inherit that mask, or unload and Ctrl-C could never stop it.
+        sigset_t none;
+        sigemptyset(&none);
+        ::sigprocmask(SIG_SETMASK, &none, nullptr);
         std::vector<char*> args;
         for (auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
         args.push_back(nullptr);
@@ -283,9 +288,18 @@ void Script::cmd_waitusr(const std::vector<std::string>& words) {
 
 void Script::terminate_children() {
     for (auto& [name, pid] : children_) ::kill(pid, SIGTERM);
+    // A child that ignores SIGTERM for 2 s is killed: shutdown must not hang on it.
+    auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
     for (auto& [name, pid] : children_) {
         int status;
-        ::waitpid(pid, &status, 0);
+        while (::waitpid(pid, &status, WNOHANG) == 0) {
+            if (std::chrono::steady_clock::now() > deadline) {
+                ::kill(pid, SIGKILL);
+                ::waitpid(pid, &status, 0);
+                break;
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        }
     }
     children_.clear();
 }
