@@ -50,14 +50,21 @@ double clamp_override(double v) noexcept {
 
 class Motion : public hal::Instance {
   public:
+    // `loadrt motion` publishes LinuxCNC's fixed names (axis.x.pos-cmd, joint.0.motor-pos-cmd,
+    // motion.enable), so LinuxCNC users' HAL files port; an instance given a name with names=
+    // prefixes its pins with it instead (a.axis.x.pos-cmd), so several can coexist.
+    std::string pin(std::string_view n) const {
+        return name() == fmt::format("motion.{}", index()) ? "=" + std::string(n) : std::string(n);
+    }
+
     Motion()
         : coordinates_(read_coordinates()),
           kins_(coordinates_),
           joint_count_(kins_.joint_count()),
-          motor_pos_cmd_(this, "joint.{}.motor-pos-cmd", joint_count_),
-          motor_pos_fb_(this, "joint.{}.motor-pos-fb", joint_count_),
-          f_error_(this, "joint.{}.f-error", joint_count_),
-          amp_enable_out_(this, "joint.{}.amp-enable-out", joint_count_),
+          motor_pos_cmd_(this, pin("joint.{}.motor-pos-cmd"), joint_count_),
+          motor_pos_fb_(this, pin("joint.{}.motor-pos-fb"), joint_count_),
+          f_error_(this, pin("joint.{}.f-error"), joint_count_),
+          amp_enable_out_(this, pin("joint.{}.amp-enable-out"), joint_count_),
           ring_(ring_capacity()) {
         check_num_joints();
         program_path_ = arg("program").value_or("");
@@ -227,7 +234,7 @@ class Motion : public hal::Instance {
     void make_axis_pins() {
         for (int k = 0; k < motion::kAxes; ++k) {
             if (coordinates_.find(kUpperAxes[k]) == std::string::npos) continue;
-            const std::string stem = fmt::format("axis.{}", kLowerAxes[k]);
+            const std::string stem = pin(fmt::format("axis.{}", kLowerAxes[k]));
             AxisPins a;
             a.axis = k;
             a.pos_cmd = std::make_unique<hal::Out<double>>(this, stem + ".pos-cmd");
@@ -277,24 +284,24 @@ class Motion : public hal::Instance {
     hal::Array<hal::In<double>> motor_pos_fb_;
     hal::Array<hal::Out<double>> f_error_;
     hal::Array<hal::Out<bool>> amp_enable_out_;
-    hal::Array<hal::In<bool>> amp_fault_in_{this, "joint.{}.amp-fault-in", joint_count_};
-    hal::Array<hal::Out<double>> f_error_lim_{this, "joint.{}.f-error-lim", joint_count_};
-    hal::Array<hal::Out<bool>> f_errored_{this, "joint.{}.f-errored", joint_count_};
-    hal::Array<hal::Param<double>> max_ferror_{this, "joint.{}.max-ferror", joint_count_};
+    hal::Array<hal::In<bool>> amp_fault_in_{this, pin("joint.{}.amp-fault-in"), joint_count_};
+    hal::Array<hal::Out<double>> f_error_lim_{this, pin("joint.{}.f-error-lim"), joint_count_};
+    hal::Array<hal::Out<bool>> f_errored_{this, pin("joint.{}.f-errored"), joint_count_};
+    hal::Array<hal::Param<double>> max_ferror_{this, pin("joint.{}.max-ferror"), joint_count_};
     std::vector<AxisPins> axes_;
 
-    hal::In<bool> enable_{this, "motion.enable"};
-    hal::In<bool> feed_hold_{this, "motion.feed-hold"};
-    hal::In<bool> abort_{this, "motion.abort"};
-    hal::In<double> feed_override_{this, "motion.feed-override", 1.0};
-    hal::In<double> rapid_override_{this, "motion.rapid-override", 1.0};
-    hal::Out<double> current_vel_{this, "motion.current-vel"};
-    hal::Out<std::int32_t> program_line_{this, "motion.program-line"};
-    hal::Out<bool> in_position_{this, "motion.in-position", true};
-    hal::Out<bool> fault_{this, "motion.fault"};
-    hal::Out<std::uint32_t> ignored_commands_{this, "motion.ignored-commands"};
-    hal::Out<std::uint32_t> starved_periods_{this, "motion.starved-periods"};
-    hal::Param<double> blend_tolerance_mm_{this, "motion.blend-tolerance", 0.01};
+    hal::In<bool> enable_{this, pin("motion.enable")};
+    hal::In<bool> feed_hold_{this, pin("motion.feed-hold")};
+    hal::In<bool> abort_{this, pin("motion.abort")};
+    hal::In<double> feed_override_{this, pin("motion.feed-override"), 1.0};
+    hal::In<double> rapid_override_{this, pin("motion.rapid-override"), 1.0};
+    hal::Out<double> current_vel_{this, pin("motion.current-vel")};
+    hal::Out<std::int32_t> program_line_{this, pin("motion.program-line")};
+    hal::Out<bool> in_position_{this, pin("motion.in-position"), true};
+    hal::Out<bool> fault_{this, pin("motion.fault")};
+    hal::Out<std::uint32_t> ignored_commands_{this, pin("motion.ignored-commands")};
+    hal::Out<std::uint32_t> starved_periods_{this, pin("motion.starved-periods")};
+    hal::Param<double> blend_tolerance_mm_{this, pin("motion.blend-tolerance"), 0.01};
 
     motion::SpscRing<motion::PreparedSegment> ring_;
     std::unique_ptr<motion::Sampler> sampler_;

@@ -59,6 +59,7 @@ detail::InstanceContext& context_of(Instance& owner, std::string_view what) {
 }
 
 void check_item_name(std::string_view name) {
+    if (!name.empty() && name[0] == '=') name.remove_prefix(1);
     if (name.empty()) throw Error("empty pin or parameter name");
     for (char c : name)
         if (std::isspace(static_cast<unsigned char>(c)) || c == '#' || c == '"')
@@ -117,12 +118,21 @@ bool Instance::faulted() const noexcept { return fault_.load(std::memory_order_r
 
 namespace detail {
 
+namespace {
+// "in0" -> "and2.0.in0"; "=joint.0.motor-pos-cmd" -> "joint.0.motor-pos-cmd" for components
+// that must publish LinuxCNC's fixed, unprefixed names (motion's joint.N.*, axis.L.*).
+std::string qualified(const InstanceContext& ctx, std::string_view name) {
+    if (!name.empty() && name[0] == '=') return std::string(name.substr(1));
+    return fmt::format("{}.{}", ctx.name, name);
+}
+}  // namespace
+
 void* register_pin(Instance& owner, std::string_view name, Type type, Dir dir, Value initial,
                    void* pointer_field) {
     auto& ctx = context_of(owner, "pin");
     check_item_name(name);
     Runtime& rt = *ctx.runtime;
-    auto full = fmt::format("{}.{}", ctx.name, name);
+    auto full = qualified(ctx, name);
     if (rt.pins_.count(full)) throw Error(fmt::format("duplicate pin '{}'", full));
     auto cell = ctx.building->allocate(sizeof(PinCell));
     auto* c = rt.segment_->at<PinCell>(cell);
@@ -139,7 +149,7 @@ void* register_param(Instance& owner, std::string_view name, Type type, ParamDir
     auto& ctx = context_of(owner, "parameter");
     check_item_name(name);
     Runtime& rt = *ctx.runtime;
-    auto full = fmt::format("{}.{}", ctx.name, name);
+    auto full = qualified(ctx, name);
     if (rt.params_.count(full)) throw Error(fmt::format("duplicate parameter '{}'", full));
     auto slot = ctx.building->allocate(sizeof(Value));
     *rt.segment_->at<Value>(slot) = initial;
@@ -152,7 +162,7 @@ void register_function(Instance& owner, std::string_view suffix, RealtimeFn fn, 
                        bool uses_fp) {
     auto& ctx = context_of(owner, "function");
     Runtime& rt = *ctx.runtime;
-    auto full = suffix.empty() ? ctx.name : fmt::format("{}.{}", ctx.name, suffix);
+    auto full = suffix.empty() ? ctx.name : qualified(ctx, suffix);
     if (rt.functs_.count(full)) throw Error(fmt::format("duplicate function '{}'", full));
     auto timing = ctx.building->allocate(sizeof(FunctTiming));
     rt.functs_[full] = std::make_unique<Funct>(

@@ -132,7 +132,14 @@ void Script::run_words(const std::vector<std::string>& words, std::string& out) 
         out += fmt::format("{}\n", fmt::join(rest, " "));
     } else if (cmd == "source") {
         if (words.size() != 2) throw Error("usage: source FILE");
-        if (!run_file(words[1])) throw Error(fmt::format("sourced file '{}' failed", words[1]));
+        // A relative path is looked up beside the sourcing file first, then in the working
+        // directory, so a config's files find each other wherever halrun is started.
+        std::string path = words[1];
+        if (!file_stack_.empty() && !path.empty() && path[0] != '/') {
+            auto beside = std::filesystem::path(file_stack_.back()).parent_path() / path;
+            if (std::filesystem::exists(beside)) path = beside.string();
+        }
+        if (!run_file(path)) throw Error(fmt::format("sourced file '{}' failed", words[1]));
     } else if (cmd == "loadusr") {
         cmd_loadusr(words);
     } else if (cmd == "waitusr") {

@@ -54,6 +54,7 @@ TEST_F(Rt, AFailedConstructorLeavesNothingBehind) {
     EXPECT_EQ(run("list comp"), "\n");
     run("loadrt tfailing count=3");  // the storage the failed load took is reused
     EXPECT_EQ(run("list pin tfailing.2"), "tfailing.2.a tfailing.2.b\n");
+    EXPECT_EQ(run("list pin fixed"), "fixed.0.b fixed.1.b fixed.2.b\n");  // '=' names are unprefixed
     EXPECT_LE(rt->segment().bytes_in_use(), before + 3 * 1024);
 }
 

@@ -2,6 +2,8 @@
 // function, a stream, a constructor that fails half way, a function that overruns.
 #include <time.h>
 
+#include <fmt/format.h>
+
 #include "hal/component.hpp"
 
 namespace {
@@ -34,6 +36,7 @@ struct Probe : hal::Instance {
 
 struct Failing : hal::Instance {
     hal::In<bool> a{this, "a"};
+    hal::Out<bool> fixed{this, fmt::format("=fixed.{}.b", index())};
     hal::Out<bool> b{this, "b"};
     Failing() {
         if (index() == arg_int("fail-at", -1)) throw hal::Error("refusing to build this instance");

@@ -85,6 +85,10 @@ inline void store(T* p, T v) noexcept {
 }
 }  // namespace detail
 
+// Pin, param and function names are prefixed with the instance name ("in0" -> "and2.0.in0");
+// a name starting with '=' is taken as it is ("=joint.0.motor-pos-cmd"), for components that
+// must publish LinuxCNC's fixed names.
+//
 // Per-instance view of the loadrt line, e.g. `loadrt sampler depth=1000,200 cfg=ffb,bb`.
 // A comma list gives one value per instance; arg() returns this instance's item.
 class Instance {
