@@ -526,6 +526,22 @@ TEST_F(ExecTest, M902_1_HomingSetsTheMachineCoordinate) {
     EXPECT_EQ(error_of("M902 H4"), "test.nc:7:6: M902 axis: H4 must be an integer in 0..3");
 }
 
+TEST_F(ExecTest, C31_M902InV54SetsZero) {
+    BackendConfig cfg;
+    cfg.v54_compat = true;
+    cfg.home_position_mm = {-5, 0, 0, 0, 0, 0};  // ignored in V5.4: the point becomes 0
+    make(cfg);
+    run({"G00 X30"});
+    EXPECT_EQ(run({"M902 H0"}), (V{"home-done X at=0"}));
+    EXPECT_DOUBLE_EQ(exec->machine_pos_mm(Axis::X), 0);
+}
+
+TEST_F(ExecTest, FM_3_G94IsAcceptedAsFeedPerMinute) {
+    EXPECT_EQ(run({"G94 G01 X1 F60"}),
+              (V{"feed-mode per-minute", "feed-rate 1mm/s", "feed X1 Y0 Z0"}));
+    EXPECT_EQ(error_of("G93 G01 X2"), "test.nc:7:1: unsupported G code G93");
+}
+
 TEST_F(ExecTest, NCX_3_G904ConditionalMove) {
     Block b = blk("G904");
     b.kw.f_axis[2] = -60;
