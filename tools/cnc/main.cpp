@@ -2,6 +2,7 @@
 //   cnc canon PROGRAM   print the canonical command stream (native or LinuxCNC rs274 -g form)
 //   cnc check PROGRAM   run the whole program without motion; every error as file:line:col,
 //                       then a summary (extents, tools, path length)
+//   cnc run INI PROGRAM run the program on a machine config (run.cpp)
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -16,6 +17,7 @@
 #include "interp/interpreter.hpp"
 #include "interp/persist.hpp"
 #include "interp/tooltable.hpp"
+#include "run.hpp"
 
 namespace {
 
@@ -195,7 +197,11 @@ int main(int argc, char** argv) {
     check->add_option("--max-errors", max_errors, "stop after this many errors")
         ->check(CLI::PositiveNumber);
 
+    cncrun::RunOptions run_opts;
+    CLI::App* run = cncrun::add_run_command(app, run_opts);
+
     CLI11_PARSE(app, argc, argv);
+    if (run->parsed()) return cncrun::run_program(run_opts);
     try {
         if (canon->parsed()) return run_canon(canon_opts, format, out_path);
         return run_check(check_opts, max_errors);

@@ -1,0 +1,600 @@
+// `cnc run`: the product's main job. Loads an INI, runs its [HAL]HALFILEs in a HAL instance
+// owned by this process, names the program to the motion component (environment variable
+// CNC_PROGRAM, which the config's `loadrt motion program=$(CNC_PROGRAM)` reads), starts the
+// threads and watches motion's pins until the program ends, a fault, a timeout or Ctrl-C.
+//
+// Two clocks: the real one (the HAL threads run on their own; this loop polls the pins every
+// few milliseconds) and --sim-clock (this loop advances the simulated clock one servo period
+// at a time and sees every cycle, so the output is the same on every run).
+#include "run.hpp"
+
+#include <fmt/format.h>
+#include <pthread.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "backends.hpp"
+#include "hal/ini.hpp"
+#include "hal/script.hpp"
+#include "runtime.hpp"
+#include "segment.hpp"
+
+namespace cncrun {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr double kPollPeriodS = 0.005;  // real-time clock: how often the pins are read
+constexpr double kEnableGraceS = 1.0;   // the machine must be enabled within this
+constexpr double kAbortGraceS = 10.0;   // after Ctrl-C: time allowed for the stop ramp
+constexpr double kTtyRedrawS = 0.1;     // progress bar redraw interval, wall time
+constexpr int kBarWidth = 30;
+
+// Ctrl-C, SIGTERM and SIGHUP are taken by one waiter thread, so the HAL threads (which
+// inherit the blocked mask) run undisturbed. The first request asks for a controlled stop;
+// a second one quits at once. Construct before the runtime so its threads inherit the mask.
+class StopRequest {
+  public:
+    StopRequest() {
+        sigemptyset(&set_);
+        for (int s : {SIGINT, SIGTERM, SIGHUP, SIGUSR1}) sigaddset(&set_, s);
+        pthread_sigmask(SIG_BLOCK, &set_, nullptr);
+        waiter_ = std::thread([this] { wait(); });
+    }
+    ~StopRequest() {
+        pthread_kill(waiter_.native_handle(), SIGUSR1);  // SIGUSR1 only ends the waiter
+        waiter_.join();
+    }
+    StopRequest(const StopRequest&) = delete;
+    StopRequest& operator=(const StopRequest&) = delete;
+    bool requested() const noexcept { return requested_.load(std::memory_order_relaxed); }
+
+  private:
+    void wait() {
+        for (;;) {
+            int sig = 0;
+            sigwait(&set_, &sig);
+            if (sig == SIGUSR1) return;
+            if (requested_.exchange(true)) std::_Exit(130);
+        }
+    }
+    sigset_t set_{};
+    std::atomic<bool> requested_{false};
+    std::thread waiter_;
+};
+
+// A pin, param or signal read straight from the segment, without the runtime's lock: the HAL
+// threads write these while the loop reads them (every slot is one relaxed 8-byte access).
+class Probe {
+  public:
+    Probe(hal::Runtime& rt, const std::string& name)
+        : seg_(&rt.segment()), lookup_(rt.lookup(name)) {}
+    double number() const noexcept {
+        const hal::Value v = read();
+        switch (lookup_.type) {
+            case hal::Type::Bit:
+                return v.b ? 1.0 : 0.0;
+            case hal::Type::Float:
+                return v.f;
+            case hal::Type::S32:
+                return v.s32;
+            case hal::Type::U32:
+                return v.u32;
+            case hal::Type::S64:
+                return static_cast<double>(v.s64);
+            case hal::Type::U64:
+                return static_cast<double>(v.u64);
+        }
+        return 0;
+    }
+    bool bit() const noexcept { return number() != 0; }
+
+  private:
+    hal::Value read() const noexcept {
+        std::uint64_t offset = lookup_.offset;
+        if (lookup_.kind == "pin")
+            offset = seg_->at<hal::PinCell>(offset)->data_offset.load(std::memory_order_acquire);
+        const std::uint64_t raw = std::atomic_ref<std::uint64_t>(*seg_->at<std::uint64_t>(offset))
+                                      .load(std::memory_order_relaxed);
+        hal::Value v;
+        std::memcpy(&v, &raw, sizeof v);
+        return v;
+    }
+    hal::Segment* seg_;
+    hal::Runtime::Lookup lookup_;
+};
+
+std::optional<Probe> try_probe(hal::Runtime& rt, const std::string& name) {
+    try {
+        return Probe(rt, name);
+    } catch (const hal::Error&) {
+        return std::nullopt;
+    }
+}
+
+// What the run needs from the INI, checked before anything is loaded.
+struct Config {
+    std::vector<std::string> hal_files;  // resolved against the INI's folder
+    double period_s = 0;
+    std::string axis_letters;  // lower case, once each, in [TRAJ]COORDINATES order
+    int program_lines = 0;
+};
+
+int count_lines(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) throw hal::Error(fmt::format("{}: cannot open the program", path));
+    int lines = 0;
+    std::string text;
+    while (std::getline(in, text)) ++lines;
+    return lines;
+}
+
+Config load_config(const RunOptions& o) {
+    const hal::IniFile ini = hal::IniFile::load(o.ini);
+    Config c;
+    const fs::path folder = fs::path(o.ini).parent_path();
+    for (const std::string& f : ini.all("HAL", "HALFILE"))
+        c.hal_files.push_back(fs::path(f).is_absolute() ? f : (folder / f).string());
+    if (c.hal_files.empty())
+        throw hal::Error(fmt::format("{}: [HAL]HALFILE is missing: no HAL file to load", o.ini));
+    const auto period_ns = ini.get_number("EMCMOT", "SERVO_PERIOD");
+    if (!period_ns || !(*period_ns > 0))
+        throw hal::Error(fmt::format("{}: [EMCMOT]SERVO_PERIOD (ns, > 0) is missing", o.ini));
+    c.period_s = *period_ns * 1e-9;
+    for (char ch : ini.get("TRAJ", "COORDINATES").value_or("XYZ")) {
+        const char l = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+        if (std::isalpha(static_cast<unsigned char>(l)) &&
+            c.axis_letters.find(l) == std::string::npos)
+            c.axis_letters += l;
+    }
+    c.program_lines = count_lines(o.program);
+    return c;
+}
+
+// The motion pins the loop watches. Axis and joint pins are found by name, so a config with
+// any coordinates and joint count works.
+struct MachinePins {
+    Probe in_position, fault, enable, line, vel;
+    std::string letters;  // axes that have axis.L.pos-cmd
+    std::vector<Probe> axis_cmd, ferror, ferrored, amp_fault, joint_fb;
+};
+
+MachinePins find_pins(hal::Runtime& rt, const std::string& letters) {
+    if (!try_probe(rt, "motion.in-position"))
+        throw hal::Error(
+            "the config's HAL files do not load the motion component (no pin motion.in-position)");
+    MachinePins p{Probe(rt, "motion.in-position"),
+                  Probe(rt, "motion.fault"),
+                  Probe(rt, "motion.enable"),
+                  Probe(rt, "motion.program-line"),
+                  Probe(rt, "motion.current-vel"),
+                  {},
+                  {},
+                  {},
+                  {},
+                  {},
+                  {}};
+    for (char l : letters) {
+        if (auto probe = try_probe(rt, fmt::format("axis.{}.pos-cmd", l))) {
+            p.letters += l;
+            p.axis_cmd.push_back(*probe);
+        }
+    }
+    for (int j = 0;; ++j) {
+        auto ferror = try_probe(rt, fmt::format("joint.{}.f-error", j));
+        if (!ferror) break;
+        p.ferror.push_back(*ferror);
+        p.ferrored.emplace_back(rt, fmt::format("joint.{}.f-errored", j));
+        p.amp_fault.emplace_back(rt, fmt::format("joint.{}.amp-fault-in", j));
+        p.joint_fb.emplace_back(rt, fmt::format("joint.{}.motor-pos-fb", j));
+    }
+    return p;
+}
+
+struct Sample {
+    double t_s = 0;
+    int line = 0;
+    std::vector<double> axis_mm, joint_fb_mm, ferror_mm;
+    double vel_mm_s = 0;
+    bool in_position = false, fault = false, enabled = false;
+};
+
+void read_sample(const MachinePins& p, double t_s, Sample& s) {
+    s.t_s = t_s;
+    s.line = static_cast<int>(p.line.number());
+    s.axis_mm.resize(p.axis_cmd.size());
+    for (std::size_t k = 0; k < p.axis_cmd.size(); ++k) s.axis_mm[k] = p.axis_cmd[k].number();
+    s.joint_fb_mm.resize(p.joint_fb.size());
+    s.ferror_mm.resize(p.ferror.size());
+    for (std::size_t j = 0; j < p.ferror.size(); ++j) {
+        s.joint_fb_mm[j] = p.joint_fb[j].number();
+        s.ferror_mm[j] = p.ferror[j].number();
+    }
+    s.vel_mm_s = p.vel.number();
+    s.in_position = p.in_position.bit();
+    s.fault = p.fault.bit();
+    s.enabled = p.enable.bit();
+}
+
+// Running figures for the summary. Velocities and accelerations are differences of
+// consecutive commanded positions, so they need every servo cycle (--sim-clock).
+class Stats {
+  public:
+    Stats(std::string letters, std::size_t joints, bool every_cycle, double period_s)
+        : letters_(std::move(letters)),
+          every_cycle_(every_cycle),
+          period_s_(period_s),
+          max_ferror_mm_(joints, 0.0),
+          max_vel_(letters_.size(), 0.0),
+          max_acc_(letters_.size(), 0.0),
+          prev_vel_(letters_.size(), 0.0) {}
+
+    void add(const Sample& s) {
+        for (std::size_t j = 0; j < s.ferror_mm.size(); ++j)
+            max_ferror_mm_[j] = std::max(max_ferror_mm_[j], std::fabs(s.ferror_mm[j]));
+        if (!prev_pos_.empty()) {
+            double d2 = 0;
+            for (std::size_t k = 0; k < letters_.size(); ++k) {
+                const double d = s.axis_mm[k] - prev_pos_[k];
+                if (is_linear(letters_[k])) d2 += d * d;
+                if (!every_cycle_) continue;
+                const double v = d / period_s_;
+                max_vel_[k] = std::max(max_vel_[k], std::fabs(v));
+                max_acc_[k] = std::max(max_acc_[k], std::fabs(v - prev_vel_[k]) / period_s_);
+                prev_vel_[k] = v;
+            }
+            path_mm_ += std::sqrt(d2);
+        }
+        prev_pos_ = s.axis_mm;
+    }
+
+    void print(std::FILE* out) const {
+        std::string linear;
+        for (char l : letters_)
+            if (is_linear(l)) linear += static_cast<char>(std::toupper(l));
+        fmt::print(out, "path length: {:.3f} mm ({})\n", path_mm_, linear);
+        std::string ferr;
+        for (std::size_t j = 0; j < max_ferror_mm_.size(); ++j)
+            ferr += fmt::format("{}j{} {:.4f}", j ? "  " : "", j, max_ferror_mm_[j]);
+        fmt::print(out, "max following error (mm): {}\n", ferr.empty() ? "no joints" : ferr);
+        if (!every_cycle_) {
+            fmt::print(out, "max velocity, acceleration: measured only with --sim-clock\n");
+            return;
+        }
+        fmt::print(out, "max velocity (mm/s): {}\n", per_axis(max_vel_, 3));
+        fmt::print(out, "max acceleration (mm/s^2): {}\n", per_axis(max_acc_, 1));
+    }
+
+  private:
+    static bool is_linear(char l) {
+        return std::string_view("xyzuvw").find(l) != std::string_view::npos;
+    }
+    std::string per_axis(const std::vector<double>& v, int decimals) const {
+        std::string s;
+        for (std::size_t k = 0; k < letters_.size(); ++k)
+            s += fmt::format("{}{} {:.{}f}", k ? "  " : "", letters_[k], v[k], decimals);
+        return s;
+    }
+    std::string letters_;
+    bool every_cycle_;
+    double period_s_;
+    double path_mm_ = 0;
+    std::vector<double> max_ferror_mm_, max_vel_, max_acc_, prev_vel_, prev_pos_;
+};
+
+// Progress on stdout: a redrawn bar on a terminal, otherwise one plain line per second of
+// motion time (deterministic under --sim-clock).
+class Progress {
+  public:
+    Progress(int total_lines, bool tty) : total_lines_(std::max(total_lines, 1)), tty_(tty) {}
+
+    void update(double t_s, int line) {
+        const double percent = std::min(100.0, 100.0 * line / total_lines_);
+        if (tty_) {
+            const auto now = std::chrono::steady_clock::now();
+            if (drawn_ && now - last_draw_ < std::chrono::duration<double>(kTtyRedrawS)) return;
+            last_draw_ = now;
+            drawn_ = true;
+            const int filled = static_cast<int>(percent / 100.0 * kBarWidth);
+            const std::string eta =
+                percent > 0 ? fmt::format("  ETA {:.1f} s", t_s * (100.0 - percent) / percent) : "";
+            fmt::print("\r[{}{}] {:3.0f}%  line {}/{}  {:.1f} s{}\x1b[K",
+                       std::string(static_cast<std::size_t>(filled), '#'),
+                       std::string(static_cast<std::size_t>(kBarWidth - filled), '-'), percent,
+                       line, total_lines_, t_s, eta);
+            std::fflush(stdout);
+            return;
+        }
+        if (t_s + 1e-9 < next_plain_s_) return;
+        next_plain_s_ = std::floor(t_s + 1e-9) + 1.0;
+        fmt::print("progress: {:7.1f} s  line {}/{}  {:3.0f}%\n", t_s, line, total_lines_, percent);
+    }
+
+    void finish() {
+        if (tty_ && drawn_) fmt::print("\n");
+    }
+
+  private:
+    int total_lines_;
+    bool tty_;
+    bool drawn_ = false;
+    std::chrono::steady_clock::time_point last_draw_{};
+    double next_plain_s_ = 1.0;
+};
+
+// The trace: a header row, then one row per sample: t, line, axis commands, joint feedback,
+// path velocity.
+class Trace {
+  public:
+    Trace(const std::string& path, const std::string& letters, std::size_t joints)
+        : file_(std::fopen(path.c_str(), "w"), &std::fclose) {
+        if (!file_)
+            throw hal::Error(
+                fmt::format("{}: cannot open for writing: {}", path, std::strerror(errno)));
+        std::string header = "t,line";
+        for (char l : letters) header += fmt::format(",{}", l);
+        for (std::size_t j = 0; j < joints; ++j) header += fmt::format(",j{}", j);
+        fmt::print(file_.get(), "{},vel\n", header);
+    }
+    void row(const Sample& s) {
+        std::FILE* f = file_.get();
+        fmt::print(f, "{:.6f},{}", s.t_s, s.line);
+        for (double v : s.axis_mm) fmt::print(f, ",{:.6f}", v);
+        for (double v : s.joint_fb_mm) fmt::print(f, ",{:.6f}", v);
+        fmt::print(f, ",{:.6f}\n", s.vel_mm_s);
+    }
+
+  private:
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> file_;
+};
+
+enum class Outcome { Finished, Fault, Disabled, NeverEnabled, Timeout, Interrupted };
+
+// Why motion faulted, from the joint pins of the faulting cycle.
+std::string describe_fault(const MachinePins& p, const Sample& s) {
+    for (std::size_t j = 0; j < p.ferror.size(); ++j) {
+        if (p.amp_fault[j].bit()) return fmt::format("drive fault on joint {} (amp-fault-in)", j);
+        if (p.ferrored[j].bit())
+            return fmt::format("following error on joint {}: {:.4f} mm over the limit", j,
+                               s.ferror_mm[j]);
+    }
+    return "motion fault (the planner's message follows when motion stops)";
+}
+
+// The instance this process owns, torn down on every path out.
+struct Session {
+    explicit Session(bool sim_clock)
+        : runtime({fmt::format("cnc-run-{}", ::getpid()), hal::kDefaultSegmentBytes, sim_clock}),
+          backend(runtime),
+          script(backend) {}
+    ~Session() {
+        std::string out;
+        try {
+            runtime.execute({"stop"}, out);
+        } catch (const hal::Error&) {
+        }
+        script.terminate_children();
+        runtime.shutdown();
+    }
+    Session(const Session&) = delete;
+    Session& operator=(const Session&) = delete;
+    void exec(const std::vector<std::string>& words) {
+        std::string out;
+        runtime.execute(words, out);
+        if (!out.empty()) fmt::print(stderr, "{}", out);
+    }
+    hal::Runtime runtime;
+    hal::LocalBackend backend;
+    hal::Script script;
+};
+
+// The sim configs arm their e-stop latch with a rising edge on the signal estop-reset, where
+// a real machine's operator presses reset (LinuxCNC: iocontrol.0.user-enable-out).
+void arm_estop(Session& s) {
+    const auto reset = try_probe(s.runtime, "estop-reset");
+    if (!reset) return;
+    s.exec({"sets", "estop-reset", "TRUE"});
+}
+
+struct LoopResult {
+    Outcome outcome = Outcome::Finished;
+    std::string fault_text;
+    Sample last;
+    long samples = 0;
+};
+
+// Steps the clock until the program ends or something stops it. `step` moves time on (one
+// servo period, or a poll interval of wall time) and returns the time since start.
+LoopResult watch(Session& session, const MachinePins& pins, const RunOptions& o,
+                 const std::function<double()>& step, Stats& stats, Progress& progress,
+                 Trace* trace, const StopRequest& stop) {
+    LoopResult r;
+    Sample& s = r.last;
+    bool ever_enabled = false;
+    std::optional<double> abort_at_s;
+    for (;;) {
+        read_sample(pins, step(), s);
+        ++r.samples;
+        if (trace) trace->row(s);
+        stats.add(s);
+        progress.update(s.t_s, s.line);
+        if (abort_at_s) {
+            if (s.in_position || s.t_s > *abort_at_s + kAbortGraceS) return r;
+            continue;
+        }
+        if (s.fault) {
+            r.outcome = Outcome::Fault;
+            r.fault_text = describe_fault(pins, s);
+            return r;
+        }
+        ever_enabled = ever_enabled || s.enabled;
+        if (ever_enabled && !s.enabled) {
+            r.outcome = Outcome::Disabled;
+            return r;
+        }
+        if (!ever_enabled && s.t_s >= kEnableGraceS) {
+            r.outcome = Outcome::NeverEnabled;
+            return r;
+        }
+        if (s.in_position) return r;
+        if (s.t_s >= o.timeout_s) {
+            r.outcome = Outcome::Timeout;
+            return r;
+        }
+        if (stop.requested()) {
+            r.outcome = Outcome::Interrupted;
+            abort_at_s = s.t_s;
+            session.exec({"setp", "motion.abort", "TRUE"});
+        }
+    }
+}
+
+std::function<double()> make_clock(Session& session, const RunOptions& o, double period_s) {
+    if (o.sim_clock) {
+        const std::string period = fmt::format("{:.9f}", period_s);
+        return [&session, period, period_s, cycles = 0L]() mutable {
+            std::string out;
+            session.runtime.execute({"advance", period}, out);
+            return static_cast<double>(++cycles) * period_s;
+        };
+    }
+    const auto start = std::chrono::steady_clock::now();
+    return [start, next = start]() mutable {
+        next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+            std::chrono::duration<double>(kPollPeriodS));
+        std::this_thread::sleep_until(next);
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    };
+}
+
+// The error line for an outcome other than Finished: `PROGRAM:LINE: what`.
+std::string outcome_error(const RunOptions& o, const LoopResult& r) {
+    const std::string where = fmt::format("{}:{}", o.program, r.last.line);
+    switch (r.outcome) {
+        case Outcome::Finished:
+            return "";
+        case Outcome::Fault:
+            return fmt::format("{}: {}", where, r.fault_text);
+        case Outcome::Disabled:
+            return fmt::format(
+                "{}: the machine was disabled during the program (e-stop: motion.enable went "
+                "FALSE)",
+                where);
+        case Outcome::NeverEnabled:
+            return fmt::format(
+                "{}: the machine was never enabled (motion.enable stayed FALSE for {} s)", where,
+                kEnableGraceS);
+        case Outcome::Timeout:
+            return fmt::format("{}: not finished after {} s of motion (--timeout)", where,
+                               o.timeout_s);
+        case Outcome::Interrupted:
+            return fmt::format("{}: stopped by the operator (Ctrl-C)", where);
+    }
+    return "";
+}
+
+void print_summary(const RunOptions& o, const Config& c, const MachinePins& pins,
+                   const LoopResult& r, const Stats& stats, const std::string& error) {
+    fmt::print("program: {} ({} lines) on {}\n", o.program, c.program_lines, o.ini);
+    fmt::print("clock: {}, servo period {:.3f} ms\n", o.sim_clock ? "simulated" : "real time",
+               c.period_s * 1e3);
+    fmt::print("result: {}\n", r.outcome == Outcome::Finished      ? "finished"
+                               : r.outcome == Outcome::Interrupted ? "stopped (Ctrl-C)"
+                                                                   : "error");
+    fmt::print("motion time: {:.3f} s\n", r.last.t_s);
+    stats.print(stdout);
+    std::string pos;
+    for (std::size_t k = 0; k < pins.letters.size(); ++k)
+        pos += fmt::format("{}{} {:.4f}", k ? "  " : "", pins.letters[k], r.last.axis_mm[k]);
+    fmt::print("final position (mm): {}\n", pos);
+    fmt::print("errors: {}\n", error.empty() ? "none" : error);
+}
+
+int run_session(const RunOptions& o, const Config& c, Session& session, const StopRequest& stop) {
+    session.script.load_ini(o.ini);
+    for (const std::string& f : c.hal_files)
+        if (!session.script.run_file(f)) return 1;  // run_file printed file:line: cause
+    const MachinePins pins = find_pins(session.runtime, c.axis_letters);
+    std::unique_ptr<Trace> trace;
+    if (!o.trace_path.empty())
+        trace = std::make_unique<Trace>(o.trace_path, pins.letters, pins.ferror.size());
+    try {
+        session.exec({"start"});  // motion plans the program here: a bad one fails now
+    } catch (const hal::Error& e) {
+        fmt::print(stderr, "{}\n", e.what());
+        return 1;
+    }
+    arm_estop(session);
+
+    Stats stats(pins.letters, pins.ferror.size(), o.sim_clock, c.period_s);
+    Progress progress(c.program_lines, ::isatty(STDOUT_FILENO) == 1);
+    const LoopResult r = watch(session, pins, o, make_clock(session, o, c.period_s), stats,
+                               progress, trace.get(), stop);
+    progress.finish();
+    session.exec({"stop"});  // motion prints a late planner error here
+    const std::string error = outcome_error(o, r);
+    print_summary(o, c, pins, r, stats, error);
+    if (error.empty()) return 0;
+    fmt::print(stderr, "{}\n", error);
+    return r.outcome == Outcome::Interrupted ? 130 : 1;
+}
+
+}  // namespace
+
+CLI::App* add_run_command(CLI::App& app, RunOptions& o) {
+    CLI::App* cmd = app.add_subcommand(
+        "run", "run a G-code program on a machine config: progress, then a summary");
+    cmd->add_option("INI", o.ini, "machine config (LinuxCNC-style INI with [HAL]HALFILE)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    cmd->add_option("PROGRAM", o.program, "G-code program")->required()->check(CLI::ExistingFile);
+    cmd->add_flag("--sim-clock", o.sim_clock,
+                  "simulated clock: as fast as the CPU allows, every servo cycle seen, "
+                  "identical output on every run");
+    cmd->add_option("--trace", o.trace_path,
+                    "CSV of t,line,axes,joints,vel: every servo cycle with --sim-clock, "
+                    "every poll (5 ms) otherwise");
+    cmd->add_option("--timeout", o.timeout_s, "give up after this much motion time, s")
+        ->check(CLI::PositiveNumber);
+    return cmd;
+}
+
+int run_program(const RunOptions& o) {
+    Config c;
+    try {
+        c = load_config(o);
+    } catch (const hal::Error& e) {
+        fmt::print(stderr, "{}\n", e.what());
+        return 2;
+    }
+    // The config's motion loadrt line reads these (see halfiles/motion_xyz.hal).
+    ::setenv("CNC_PROGRAM", o.program.c_str(), 1);
+    ::setenv("CNC_SIM_LOCKSTEP", o.sim_clock ? "1" : "0", 1);
+    const StopRequest stop;  // before the runtime: its threads inherit the signal mask
+    try {
+        Session session(o.sim_clock);
+        ::setenv("HAL_INSTANCE", session.runtime.paths().instance.c_str(), 1);  // loadusr children
+        return run_session(o, c, session, stop);
+    } catch (const hal::Error& e) {
+        fmt::print(stderr, "{}\n", e.what());
+        return 1;
+    }
+}
+
+}  // namespace cncrun
