@@ -1,0 +1,279 @@
+// `cnc run` on configs/sim/mill.ini: every expected figure is derived from examples/pocket.ngc
+// and the mill's INI by hand (see the comments), not copied from a run.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RunResult {
+    int exit_code = -1;
+    std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+// A scratch folder of this test's own, so tests run in parallel.
+class ScratchDir {
+  public:
+    ScratchDir() {
+        std::string tmpl = (fs::temp_directory_path() / "cnc_run_test.XXXXXX").string();
+        if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
+        path_ = tmpl;
+    }
+    ~ScratchDir() {
+        std::error_code ec;
+        fs::remove_all(path_, ec);
+    }
+    const fs::path& path() const { return path_; }
+
+  private:
+    fs::path path_;
+};
+
+RunResult run_cnc(const std::string& args, const fs::path& scratch) {
+    const fs::path out = scratch / "stdout.txt", err = scratch / "stderr.txt";
+    const std::string cmd = fmt::format("cd '{}' && '{}' run {} > '{}' 2> '{}'", CNC_SOURCE_DIR,
+                                        CNC_BIN, args, out.string(), err.string());
+    const int status = std::system(cmd.c_str());
+    RunResult r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+}
+
+// The text after "KEY: " on the summary line that starts with KEY, or "".
+std::string summary_field(const std::string& out, const std::string& key) {
+    std::istringstream in(out);
+    std::string line;
+    const std::string prefix = key + ": ";
+    while (std::getline(in, line))
+        if (line.compare(0, prefix.size(), prefix) == 0) return line.substr(prefix.size());
+    return "";
+}
+
+double summary_number(const std::string& out, const std::string& key) {
+    const std::string field = summary_field(out, key);
+    return field.empty() ? NAN : std::stod(field);
+}
+
+// "x 1.0  y 2.0 ..." -> {1.0, 2.0, ...}
+std::vector<double> summary_axes(const std::string& out, const std::string& key) {
+    std::vector<double> v;
+    std::istringstream in(summary_field(out, key));
+    std::string name;
+    double x;
+    while (in >> name >> x) v.push_back(x);
+    return v;
+}
+
+std::vector<std::vector<double>> csv_rows(const std::string& text, std::string& header) {
+    std::istringstream in(text);
+    std::getline(in, header);
+    std::vector<std::vector<double>> rows;
+    std::string line;
+    while (std::getline(in, line)) {
+        std::vector<double> row;
+        std::istringstream cells(line);
+        std::string cell;
+        while (std::getline(cells, cell, ',')) row.push_back(std::stod(cell));
+        rows.push_back(row);
+    }
+    return rows;
+}
+
+const char* kPocketArgs = "configs/sim/mill.ini examples/pocket.ngc --sim-clock";
+
+// One run of the pocket with a trace, shared by the tests that only read its results.
+class PocketRun : public ::testing::Test {
+  protected:
+    static void SetUpTestSuite() {
+        scratch_ = new ScratchDir;
+        result_ = new RunResult(run_cnc(
+            fmt::format("{} --trace '{}'", kPocketArgs, (scratch_->path() / "t.csv").string()),
+            scratch_->path()));
+        trace_ = new std::string(slurp(scratch_->path() / "t.csv"));
+    }
+    static void TearDownTestSuite() {
+        delete trace_;
+        delete result_;
+        delete scratch_;
+    }
+    static ScratchDir* scratch_;
+    static RunResult* result_;
+    static std::string* trace_;
+};
+ScratchDir* PocketRun::scratch_ = nullptr;
+RunResult* PocketRun::result_ = nullptr;
+std::string* PocketRun::trace_ = nullptr;
+
+TEST_F(PocketRun, FinishesWithoutErrors) {
+    EXPECT_EQ(result_->exit_code, 0) << result_->err;
+    EXPECT_EQ(result_->err, "");
+    EXPECT_NE(result_->out.find("\nresult: finished\n"), std::string::npos) << result_->out;
+    EXPECT_NE(result_->out.find("\nerrors: none\n"), std::string::npos);
+    EXPECT_NE(
+        result_->out.find("program: examples/pocket.ngc (25 lines) on configs/sim/mill.ini\n"),
+        std::string::npos);
+}
+
+TEST_F(PocketRun, EndsAtTheProgramsLastPoint) {
+    // The program ends with G00 Z0 then G00 X10 Y5 (M30 moves nothing).
+    EXPECT_NE(result_->out.find("\nfinal position (mm): x 10.0000  y 5.0000  z 0.0000\n"),
+              std::string::npos)
+        << result_->out;
+}
+
+TEST_F(PocketRun, PathLengthMatchesTheGeometry) {
+    // Rapid (0,0)->(25,20): sqrt(25^2 + 20^2) = 32.0156; two passes of the outline: 2 x 30 +
+    // 2 x 20 straight + four R5 quarter arcs (2 pi 5 = 31.4159) = 131.4159 each; plunges
+    // 0.5 + 0.5, retract 1; rapid (25,20)->(10,5): 15 sqrt 2 = 21.2132. Total 318.0607.
+    // Corner blends (tolerance 0.01 mm) only shorten it, by a few hundredths at most.
+    const double length = summary_number(result_->out, "path length");
+    EXPECT_LE(length, 318.0607 + 1e-3);
+    EXPECT_GE(length, 318.0607 - 0.1);
+}
+
+TEST_F(PocketRun, MotionTimeIsBetweenTheBoundAndAReasonableMargin) {
+    // Bound at the programmed feeds and the axis limits: 2 x 131.4159 mm at F1200 (20 mm/s) =
+    // 13.1416 s, 1 mm of plunge at F300 = 0.2 s, rapid to (25,20) with X at 100 mm/s = 0.25 s,
+    // 1 mm retract at Z's 50 mm/s = 0.02 s, diagonal 21.2132 mm with both axes at 100 mm/s =
+    // 0.15 s: 13.76 s. Acceleration at the stops (90-degree plunge corners) adds a little.
+    const double t = summary_number(result_->out, "motion time");
+    EXPECT_GE(t, 13.76);
+    EXPECT_LE(t, 13.76 * 1.25);
+}
+
+TEST_F(PocketRun, LimitsAreRespected) {
+    // mill.ini: X and Y 100 mm/s, 1000 mm/s^2; Z 50 mm/s, 500 mm/s^2.
+    const auto vel = summary_axes(result_->out, "max velocity (mm/s)");
+    const auto acc = summary_axes(result_->out, "max acceleration (mm/s^2)");
+    ASSERT_EQ(vel.size(), 3u) << result_->out;
+    ASSERT_EQ(acc.size(), 3u);
+    EXPECT_LE(vel[0], 100 + 1e-3);
+    EXPECT_LE(vel[1], 100 + 1e-3);
+    EXPECT_LE(vel[2], 50 + 1e-3);
+    EXPECT_LE(acc[0], 1000 + 0.1);
+    EXPECT_LE(acc[1], 1000 + 0.1);
+    EXPECT_LE(acc[2], 500 + 0.1);
+    EXPECT_GT(vel[0], 20);  // the rapids are faster than the feed
+}
+
+TEST_F(PocketRun, FollowingErrorIsOnePeriodOfTravel) {
+    // Ideal followers with no lag: motion compares this period's command with the feedback of
+    // the last one, so |f-error| <= speed x 1 ms + half an encoder count (1000 counts/mm):
+    // X, Y <= 100 x 0.001 + 0.0005; Z <= 50 x 0.001 + 0.0005.
+    const auto ferr = summary_axes(result_->out, "max following error (mm)");
+    ASSERT_EQ(ferr.size(), 3u) << result_->out;
+    EXPECT_LE(ferr[0], 0.1005 + 1e-9);
+    EXPECT_LE(ferr[1], 0.1005 + 1e-9);
+    EXPECT_LE(ferr[2], 0.0505 + 1e-9);
+    EXPECT_GT(ferr[0], 0.0);
+}
+
+TEST_F(PocketRun, TraceHasOneRowPerServoCycleInsideTheProgramsExtents) {
+    std::string header;
+    const auto rows = csv_rows(*trace_, header);
+    EXPECT_EQ(header, "t,line,x,y,z,j0,j1,j2,vel");
+    ASSERT_FALSE(rows.empty());
+    const double t = summary_number(result_->out, "motion time");
+    EXPECT_EQ(static_cast<long>(rows.size()), std::lround(t / 0.001));
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+        ASSERT_EQ(rows[i].size(), 9u);
+        EXPECT_NEAR(rows[i][0], 0.001 * static_cast<double>(i + 1), 1e-9);
+        // The program stays within X 0..60, Y 0..50, Z -1..0 (cnc check's extents); blends
+        // cut inside corners, never outside the hull.
+        EXPECT_GE(rows[i][2], -1e-6);
+        EXPECT_LE(rows[i][2], 60 + 1e-6);
+        EXPECT_GE(rows[i][3], -1e-6);
+        EXPECT_LE(rows[i][3], 50 + 1e-6);
+        EXPECT_GE(rows[i][4], -1 - 1e-6);
+        EXPECT_LE(rows[i][4], 1e-6);
+        if (::testing::Test::HasFailure()) break;
+    }
+    const auto& last = rows.back();
+    EXPECT_NEAR(last[2], 10, 1e-6);
+    EXPECT_NEAR(last[3], 5, 1e-6);
+    EXPECT_NEAR(last[4], 0, 1e-6);
+    EXPECT_EQ(last[8], 0);  // at rest
+}
+
+TEST_F(PocketRun, PlainProgressLinesOncePerSecond) {
+    // stdout is a file: one "progress:" line per whole second of motion time.
+    const double t = summary_number(result_->out, "motion time");
+    std::size_t lines = 0;
+    for (std::size_t at = 0; (at = result_->out.find("progress: ", at)) != std::string::npos; ++at)
+        ++lines;
+    EXPECT_EQ(lines, static_cast<std::size_t>(std::floor(t)));
+    EXPECT_EQ(result_->out.find('\r'), std::string::npos);
+}
+
+TEST_F(PocketRun, OutputIsByteIdenticalAcrossRuns) {
+    ScratchDir scratch;
+    const RunResult again =
+        run_cnc(fmt::format("{} --trace '{}'", kPocketArgs, (scratch.path() / "t.csv").string()),
+                scratch.path());
+    EXPECT_EQ(again.exit_code, 0);
+    EXPECT_EQ(again.out, result_->out);
+    EXPECT_TRUE(slurp(scratch.path() / "t.csv") == *trace_) << "traces differ";
+}
+
+TEST(CncRunErrors, BadProgramNamesFileAndLineAndMovesNothing) {
+    ScratchDir scratch;
+    const fs::path bad = scratch.path() / "bad.ngc";
+    std::ofstream(bad) << "G90 G21\nG01 X10 F600\nG01 X20 Y#\nM30\n";
+    const RunResult r =
+        run_cnc(fmt::format("configs/sim/mill.ini '{}' --sim-clock", bad.string()), scratch.path());
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.err.rfind(bad.string() + ":3:", 0), 0u) << r.err;
+    EXPECT_EQ(r.out.find("final position"), std::string::npos) << "nothing may run";
+}
+
+TEST(CncRunErrors, FeedMoveWithoutFeedIsRefusedBeforeMotion) {
+    ScratchDir scratch;
+    const fs::path bad = scratch.path() / "nofeed.ngc";
+    std::ofstream(bad) << "G90 G21\nG01 X10\nM30\n";
+    const RunResult r =
+        run_cnc(fmt::format("configs/sim/mill.ini '{}' --sim-clock", bad.string()), scratch.path());
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.err.rfind(bad.string() + ":2:", 0), 0u) << r.err;
+}
+
+TEST(CncRunErrors, TimeoutStopsWithTheLineReached) {
+    ScratchDir scratch;
+    const RunResult r = run_cnc(fmt::format("{} --timeout 2", kPocketArgs), scratch.path());
+    EXPECT_EQ(r.exit_code, 1);
+    // After 2 s: 0.3 s of rapid and plunge, then 1.7 s at 20 mm/s along the 30 mm line 6.
+    EXPECT_NE(r.err.find("examples/pocket.ngc:6: not finished after 2 s of motion"),
+              std::string::npos)
+        << r.err;
+    EXPECT_NE(r.out.find("\nresult: error\n"), std::string::npos);
+}
+
+TEST(CncRunErrors, IniWithoutHalFileIsAConfigError) {
+    ScratchDir scratch;
+    const fs::path ini = scratch.path() / "empty.ini";
+    std::ofstream(ini) << "[EMCMOT]\nSERVO_PERIOD = 1000000\n";
+    const RunResult r =
+        run_cnc(fmt::format("'{}' examples/pocket.ngc --sim-clock", ini.string()), scratch.path());
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("[HAL]HALFILE is missing"), std::string::npos) << r.err;
+}
+
+}  // namespace
