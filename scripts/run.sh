@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# Installs dependencies, builds, and runs the main job on the simulated machine.
-# Until the motion stack lands this is the HAL demo: a PID loop on a simulated axis.
+# Installs dependencies, builds, and runs the main job: the sample part examples/pocket.ngc on
+# the simulated 3-axis mill configs/sim/mill.ini, in real time, with a progress bar and a
+# summary (docs/cnc-run.md). Extra arguments go to `cnc run` (e.g. --sim-clock, --trace t.csv).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/deps.sh
 scripts/build.sh
-exec build/bin/halrun configs/demo/pid-demo.hal
+exec build/bin/cnc run configs/sim/mill.ini examples/pocket.ngc "$@"
