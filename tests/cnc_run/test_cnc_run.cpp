@@ -277,3 +277,57 @@ TEST(CncRunErrors, IniWithoutHalFileIsAConfigError) {
 }
 
 }  // namespace
+
+namespace {
+
+// The other sim configs run the same pocket; their axes end where the program ends.
+class OtherConfigs : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(OtherConfigs, PocketFinishesAtTheProgramsLastPoint) {
+    ScratchDir scratch;
+    const RunResult r =
+        run_cnc(fmt::format("configs/sim/{}.ini examples/pocket.ngc --sim-clock", GetParam()),
+                scratch.path());
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("\nfinal position (mm): x 10.0000  y 5.0000  z 0.0000\n"),
+              std::string::npos)
+        << r.out;
+    // Same geometry as on the mill (PocketRun.PathLengthMatchesTheGeometry).
+    const double length = summary_number(r.out, "path length");
+    EXPECT_LE(length, 318.0607 + 1e-3);
+    EXPECT_GE(length, 318.0607 - 0.1);
+}
+
+INSTANTIATE_TEST_SUITE_P(Sim, OtherConfigs, ::testing::Values("mill-servo", "gantry", "corexy"),
+                         [](const auto& info) {
+                             std::string n = info.param;
+                             for (char& c : n)
+                                 if (c == '-') c = '_';
+                             return n;
+                         });
+
+TEST(FiveAxis, RotaryMovesEndAtTheProgrammedAngles) {
+    ScratchDir scratch;
+    const fs::path prog = scratch.path() / "five.ngc";
+    std::ofstream(prog) << "G90 G21\nG00 X10 Y5 Z-10\nG01 A30 F600\nG01 C90\nG01 X20 F1200\nM30\n";
+    const fs::path csv = scratch.path() / "t.csv";
+    const RunResult r =
+        run_cnc(fmt::format("configs/sim/5axis-trt.ini '{}' --sim-clock --trace '{}'",
+                            prog.string(), csv.string()),
+                scratch.path());
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find(
+                  "\nfinal position (mm): x 20.0000  y 5.0000  z -10.0000  a 30.0000  c 90.0000\n"),
+              std::string::npos)
+        << r.out;
+    // Path length counts the linear axes only. NcStudio's G00 moving down goes XY first, then
+    // Z: |(10,5)| = 11.1803, then 10 down, then the 10 mm X move: 31.1803, less a blend.
+    const double length = summary_number(r.out, "path length");
+    EXPECT_LE(length, 31.1803 + 1e-3);
+    EXPECT_GE(length, 31.1803 - 0.05);
+    std::string header;
+    csv_rows(slurp(csv), header);
+    EXPECT_EQ(header, "t,line,x,y,z,a,c,j0,j1,j2,j3,j4,vel");
+}
+
+}  // namespace
