@@ -46,9 +46,10 @@ class ScratchDir {
     fs::path path_;
 };
 
-RunResult run_cnc(const std::string& args, const fs::path& scratch) {
+RunResult run_cnc(const std::string& args, const fs::path& scratch,
+                  const fs::path& cwd = CNC_SOURCE_DIR) {
     const fs::path out = scratch / "stdout.txt", err = scratch / "stderr.txt";
-    const std::string cmd = fmt::format("cd '{}' && '{}' run {} > '{}' 2> '{}'", CNC_SOURCE_DIR,
+    const std::string cmd = fmt::format("cd '{}' && '{}' run {} > '{}' 2> '{}'", cwd.string(),
                                         CNC_BIN, args, out.string(), err.string());
     const int status = std::system(cmd.c_str());
     RunResult r;
@@ -328,6 +329,59 @@ TEST(FiveAxis, RotaryMovesEndAtTheProgrammedAngles) {
     std::string header;
     csv_rows(slurp(csv), header);
     EXPECT_EQ(header, "t,line,x,y,z,a,c,j0,j1,j2,j3,j4,vel");
+}
+
+}  // namespace
+
+namespace {
+
+// mill.ini with every [JOINT_N]FERROR lowered to 0.05 mm and the HAL files by absolute path.
+std::string mill_ini_with_tight_ferror() {
+    std::istringstream in(slurp(fs::path(CNC_SOURCE_DIR) / "configs/sim/mill.ini"));
+    std::string text, line;
+    while (std::getline(in, line)) {
+        if (line.rfind("HALFILE = ", 0) == 0)
+            line = fmt::format("HALFILE = {}/configs/sim/{}", CNC_SOURCE_DIR, line.substr(10));
+        if (line.rfind("FERROR = ", 0) == 0) line = "FERROR = 0.05";
+        text += line + "\n";
+    }
+    return text;
+}
+
+TEST(CncRunErrors, FollowingErrorTripNamesLineAndJoint) {
+    ScratchDir scratch;
+    const fs::path ini = scratch.path() / "tight.ini";
+    std::ofstream(ini) << mill_ini_with_tight_ferror();
+    const RunResult r =
+        run_cnc(fmt::format("'{}' examples/pocket.ngc --sim-clock", ini.string()), scratch.path());
+    EXPECT_EQ(r.exit_code, 1);
+    // f-error is about one period of travel: it passes 0.05 mm when X, the faster axis of the
+    // first rapid (line 4, X25 Y20), passes 50 mm/s on its way to 100 mm/s. One period later it
+    // is at most 1000 mm/s^2 x 1 ms x 1 ms + half a count (0.0005) beyond.
+    const std::string prefix = "examples/pocket.ngc:4: following error on joint 0: ";
+    ASSERT_EQ(r.err.rfind(prefix, 0), 0u) << r.err;
+    const double ferror_mm = std::stod(r.err.substr(prefix.size()));
+    EXPECT_GT(ferror_mm, 0.05);
+    EXPECT_LE(ferror_mm, 0.05 + 0.001 + 0.0005);
+    EXPECT_NE(r.out.find("\nresult: error\n"), std::string::npos);
+}
+
+}  // namespace
+
+namespace {
+
+TEST(CncRunFolders, RunsFromAnyWorkingFolder) {
+    // The sim INIs' HALLIB is found beside the sourcing HAL file, not in the working folder.
+    ScratchDir scratch;
+    const fs::path root = CNC_SOURCE_DIR;
+    const RunResult r =
+        run_cnc(fmt::format("'{}' '{}' --sim-clock", (root / "configs/sim/mill.ini").string(),
+                            (root / "examples/pocket.ngc").string()),
+                scratch.path(), scratch.path());
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("\nfinal position (mm): x 10.0000  y 5.0000  z 0.0000\n"),
+              std::string::npos)
+        << r.out;
 }
 
 }  // namespace

@@ -172,7 +172,7 @@ Config load_config(const RunOptions& o) {
 struct MachinePins {
     Probe in_position, fault, enable, line, vel;
     std::string letters;  // axes that have axis.L.pos-cmd
-    std::vector<Probe> axis_cmd, ferror, ferrored, amp_fault, joint_fb;
+    std::vector<Probe> axis_cmd, ferror, ferror_limit, ferrored, amp_fault, joint_fb;
 };
 
 MachinePins find_pins(hal::Runtime& rt, const std::string& letters) {
@@ -189,6 +189,7 @@ MachinePins find_pins(hal::Runtime& rt, const std::string& letters) {
                   {},
                   {},
                   {},
+                  {},
                   {}};
     for (char l : letters) {
         if (auto probe = try_probe(rt, fmt::format("axis.{}.pos-cmd", l))) {
@@ -200,6 +201,7 @@ MachinePins find_pins(hal::Runtime& rt, const std::string& letters) {
         auto ferror = try_probe(rt, fmt::format("joint.{}.f-error", j));
         if (!ferror) break;
         p.ferror.push_back(*ferror);
+        p.ferror_limit.emplace_back(rt, fmt::format("joint.{}.f-error-lim", j));
         p.ferrored.emplace_back(rt, fmt::format("joint.{}.f-errored", j));
         p.amp_fault.emplace_back(rt, fmt::format("joint.{}.amp-fault-in", j));
         p.joint_fb.emplace_back(rt, fmt::format("joint.{}.motor-pos-fb", j));
@@ -371,8 +373,8 @@ std::string describe_fault(const MachinePins& p, const Sample& s) {
     for (std::size_t j = 0; j < p.ferror.size(); ++j) {
         if (p.amp_fault[j].bit()) return fmt::format("drive fault on joint {} (amp-fault-in)", j);
         if (p.ferrored[j].bit())
-            return fmt::format("following error on joint {}: {:.4f} mm over the limit", j,
-                               s.ferror_mm[j]);
+            return fmt::format("following error on joint {}: {:.4f} mm, over its limit {} mm", j,
+                               s.ferror_mm[j], p.ferror_limit[j].number());
     }
     return "motion fault (the planner's message follows when motion stops)";
 }
