@@ -385,3 +385,33 @@ TEST(CncRunFolders, RunsFromAnyWorkingFolder) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(CncRunStop, SigtermAbortsWithAControlledStop) {
+    // Real time: the pocket takes about 15 s; SIGTERM (as Ctrl-C) after 1 s aborts it. The shell
+    // runs cnc in the background, where SIGINT would be ignored, hence SIGTERM.
+    ScratchDir scratch;
+    const fs::path out = scratch.path() / "stdout.txt", err = scratch.path() / "stderr.txt";
+    const std::string cmd = fmt::format(
+        "cd '{}' && {{ '{}' run configs/sim/mill.ini examples/pocket.ngc > '{}' 2> '{}' & "
+        "pid=$!; sleep 1; kill -TERM $pid; wait $pid; }}",
+        CNC_SOURCE_DIR, CNC_BIN, out.string(), err.string());
+    const int status = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 130);
+    const std::string o = slurp(out), e = slurp(err);
+    EXPECT_NE(e.find("stopped on request (Ctrl-C or SIGTERM)"), std::string::npos) << e;
+    EXPECT_NE(o.find("\nresult: stopped on request\n"), std::string::npos) << o;
+    // Stopped along the path, inside the program's extents (X 0..60, Y 0..50, Z -1..0), not
+    // at its end (X10 Y5 after about 15 s).
+    const auto pos = summary_axes(o, "final position (mm)");
+    ASSERT_EQ(pos.size(), 3u) << o;
+    EXPECT_GE(pos[0], 0);
+    EXPECT_LE(pos[0], 60);
+    EXPECT_GE(pos[1], 0);
+    EXPECT_LE(pos[1], 50);
+    EXPECT_LT(summary_number(o, "motion time"), 10.0);
+}
+
+}  // namespace

@@ -328,8 +328,14 @@ class Progress {
         fmt::print("progress: {:7.1f} s  line {}/{}  {:3.0f}%\n", t_s, line, total_lines_, percent);
     }
 
-    void finish() {
-        if (tty_ && drawn_) fmt::print("\n");
+    // A finished program leaves the bar at 100 %, whatever line the last redraw showed.
+    void finish(double t_s, bool finished) {
+        if (!tty_ || !drawn_) return;
+        if (finished) {
+            drawn_ = false;  // force the redraw
+            update(t_s, total_lines_);
+        }
+        fmt::print("\n");
     }
 
   private:
@@ -506,7 +512,7 @@ std::string outcome_error(const RunOptions& o, const LoopResult& r) {
             return fmt::format("{}: not finished after {} s of motion (--timeout)", where,
                                o.timeout_s);
         case Outcome::Interrupted:
-            return fmt::format("{}: stopped by the operator (Ctrl-C)", where);
+            return fmt::format("{}: stopped on request (Ctrl-C or SIGTERM)", where);
     }
     return "";
 }
@@ -517,7 +523,7 @@ void print_summary(const RunOptions& o, const Config& c, const MachinePins& pins
     fmt::print("clock: {}, servo period {:.3f} ms\n", o.sim_clock ? "simulated" : "real time",
                c.period_s * 1e3);
     fmt::print("result: {}\n", r.outcome == Outcome::Finished      ? "finished"
-                               : r.outcome == Outcome::Interrupted ? "stopped (Ctrl-C)"
+                               : r.outcome == Outcome::Interrupted ? "stopped on request"
                                                                    : "error");
     fmt::print("motion time: {:.3f} s\n", r.last.t_s);
     stats.print(stdout);
@@ -548,7 +554,7 @@ int run_session(const RunOptions& o, const Config& c, Session& session, const St
     Progress progress(c.program_lines, ::isatty(STDOUT_FILENO) == 1);
     const LoopResult r = watch(session, pins, o, make_clock(session, o, c.period_s), stats,
                                progress, trace.get(), stop);
-    progress.finish();
+    progress.finish(r.last.t_s, r.outcome == Outcome::Finished);
     session.exec({"stop"});  // motion prints a late planner error here
     const std::string error = outcome_error(o, r);
     print_summary(o, c, pins, r, stats, error);
