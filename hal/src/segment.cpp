@@ -10,6 +10,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -50,24 +51,33 @@ InstancePaths InstancePaths::for_instance(const std::string& instance) {
     return p;
 }
 
-std::uint64_t process_start_time(pid_t pid) {
+namespace {
+// Fields of /proc/<pid>/stat after the command name, which may contain spaces and
+// parentheses: field 3 (state) is the first.
+std::vector<std::string> stat_fields(pid_t pid) {
     std::ifstream in(fmt::format("/proc/{}/stat", pid));
     std::string line;
-    if (!std::getline(in, line)) return 0;
-    // The command name may contain spaces and parentheses; fields resume after the last ')'.
+    if (!std::getline(in, line)) return {};
     auto close = line.rfind(')');
-    if (close == std::string::npos) return 0;
-    std::istringstream fields(line.substr(close + 2));
-    std::string field;
-    for (int i = 3; i <= 22 && fields >> field; ++i)
-        if (i == 22) return std::stoull(field);
-    return 0;
+    if (close == std::string::npos || close + 2 > line.size()) return {};
+    std::istringstream stream(line.substr(close + 2));
+    std::vector<std::string> fields;
+    for (std::string f; stream >> f;) fields.push_back(f);
+    return fields;
+}
+}  // namespace
+
+std::uint64_t process_start_time(pid_t pid) {
+    auto f = stat_fields(pid);
+    return f.size() > 19 ? std::stoull(f[19]) : 0;  // field 22
 }
 
 bool process_alive(pid_t pid, std::uint64_t start_time) {
     if (pid <= 0) return false;
-    if (::kill(pid, 0) != 0 && errno == ESRCH) return false;
-    return process_start_time(pid) == start_time;
+    auto f = stat_fields(pid);
+    // A zombie (Z) or dead (X) owner no longer holds anything, even before it is reaped.
+    if (f.empty() || f[0] == "Z" || f[0] == "X") return false;
+    return f.size() > 19 && std::stoull(f[19]) == start_time;
 }
 
 std::unique_ptr<Segment> Segment::create(const InstancePaths& paths, std::size_t bytes,

@@ -12,23 +12,29 @@
 #include <fmt/format.h>
 
 #include "backends.hpp"
+#include "segment.hpp"
 
 namespace {
 
 void start_owner(const std::string& instance) {
     auto self = std::filesystem::read_symlink("/proc/self/exe");
     auto halrun = (self.parent_path() / "halrun").string();
+    // The owner outlives this halcmd: it must not hold our terminal or pipes open, so its
+    // output goes to a log beside the instance's socket.
+    auto log = std::filesystem::path(hal::InstancePaths::for_instance(instance).socket_path).replace_extension(".log");
     pid_t pid = ::fork();
     if (pid == 0) {
         ::setsid();
         std::freopen("/dev/null", "r", stdin);
-        std::freopen("/dev/null", "w", stdout);
+        std::freopen(log.c_str(), "w", stdout);
+        std::freopen(log.c_str(), "a", stderr);
         execl(halrun.c_str(), "halrun", "--serve", "--instance", instance.c_str(), static_cast<char*>(nullptr));
         ::_exit(127);
     }
     for (int i = 0; i < 500; ++i) {
         if (hal::Connection::running(instance)) {
-            fmt::print(stderr, "halcmd: started HAL instance '{}' (stop it with 'halrun -U')\n", instance);
+            fmt::print(stderr, "halcmd: started HAL instance '{}' (stop it with 'halrun -U'; its log: {})\n",
+                       instance, log.string());
             return;
         }
         std::this_thread::sleep_for(std::chrono::milliseconds(10));
