@@ -32,6 +32,7 @@ struct BackendConfig {
     bool t_changes_tool = true;      // cfg:t_changes_tool (NcStudio 6th: T changes the tool)
     bool end_stops_spindle = true;   // AUTOSTOPSPINDLE: M02/M30 stop spindle and coolant
     double max_rapid_mm_s = 0;       // clamp for F in G00 blocks; 0 = no clamp
+    double max_feed_mm_s = 0;        // FEED-8: cutting feeds are clamped to this; 0 = no clamp
     // The machine's default cutting feed, used by a feed move when no F was ever programmed
     // (NcStudio always has one; the manual's examples rely on it). 0 = such a move is an error.
     double default_feed_mm_s = 0;
@@ -60,6 +61,7 @@ struct ExecState {
     IoState io;
     cycles::CycleState cycle;        // active canned cycle and its modal data (G80 = none)
     bool cycle_return_to_r = false;  // G99 (else G98)
+    bool feed_clamp_warned = false;  // FEED-8: warn once per program
     cutter::Side crc_side = cutter::Side::Off;  // G40/G41/G42 as programmed
     std::optional<int> crc_d;                   // last D word (selects the radius)
     CrcBlockState crc;     // what the compensator gets for this block (mirroring swaps the side)

@@ -340,6 +340,7 @@ void BlockRun::program_end(bool rewind) {
     st.cycle.cancel();
     st.cycle_return_to_r = false;
     st.crc_side = cutter::Side::Off;
+    st.feed_clamp_warned = false;
     st.coord.g992_mm = {};
     st.coord.g992_active = false;
     st.motion = MotionModal{};

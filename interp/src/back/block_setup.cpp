@@ -41,9 +41,17 @@ void BlockRun::step_feed() {
         emit(canon::SetRapidRate{r});
         if (st.feed.feed_set) return;  // G00-3 REC: a first bare F also primes the cutting feed
     }
-    st.feed.feed_mm_s = f_mm_s;
+    double cut_mm_s = f_mm_s;
+    if (cfg_.max_feed_mm_s > 0 && cut_mm_s > cfg_.max_feed_mm_s) {
+        cut_mm_s = cfg_.max_feed_mm_s;
+        if (!st.feed_clamp_warned)
+            emit(canon::Warning{fmt::format("F{} exceeds the maximum feed {} mm/min; clamped",
+                                            fmt_num(f), fmt_num(cut_mm_s * 60.0))});
+        st.feed_clamp_warned = true;
+    }
+    st.feed.feed_mm_s = cut_mm_s;
     st.feed.feed_set = true;
-    emit(canon::SetFeedRate{f_mm_s});
+    emit(canon::SetFeedRate{cut_mm_s});
 }
 
 void BlockRun::step_spindle_speed() {

@@ -80,6 +80,20 @@ TEST_F(ExecTest, G00_3_FInRapidBlockSetsRapidOnly) {
     EXPECT_EQ(run({"G01 X4 F300"}), (V{"feed-rate 5mm/s", "feed X4 Y0 Z0"}));
 }
 
+TEST_F(ExecTest, FEED_8_FeedIsClampedWithOneWarningPerProgram) {
+    BackendConfig cfg;
+    cfg.max_feed_mm_s = 100;  // 6000 mm/min
+    make(cfg);
+    EXPECT_EQ(run({"G01 X1 F9000"}),
+              (V{"warning \"F9000 exceeds the maximum feed 6000 mm/min; clamped\"",
+                 "feed-rate 100mm/s", "feed X1 Y0 Z0"}));
+    EXPECT_EQ(run({"X2 F12000"}), (V{"feed-rate 100mm/s", "feed X2 Y0 Z0"}));
+    EXPECT_EQ(run({"X3 F600"}), (V{"feed-rate 10mm/s", "feed X3 Y0 Z0"}));
+    run({"M30"});
+    EXPECT_EQ(run({"G01 X1 F9000"}).front(),
+              "warning \"F9000 exceeds the maximum feed 6000 mm/min; clamped\"");
+}
+
 TEST_F(ExecTest, G01_2_FeedMoveWithoutFeedIsAnError) {
     EXPECT_EQ(error_of("G01 X10"), "test.nc:7:1: no feed rate programmed (F) for a feed move");
 }
