@@ -17,82 +17,15 @@
 #include <cstdint>
 #include <memory>
 #include <string>
-#include <variant>
 #include <vector>
 
 #include "hal/component.hpp"
+#include "stream_args.hpp"
 
 namespace {
 
-std::string streamer_layout(const hal::Instance& self) {
-    auto cfg = self.arg("cfg");
-    if (!cfg || cfg->empty())
-        throw hal::Error(
-            "cfg=LETTERS[,LETTERS...] is required: one letter per pin "
-            "(b bit, f float, s s32, u u32, l s64, k u64)");
-    return *cfg;
-}
-
-std::uint32_t streamer_depth(const hal::Instance& self) {
-    const long depth = self.arg_int("depth", 0);
-    if (depth < 1 || depth > (1L << 24))
-        throw hal::Error("depth=N (records, 1 to 16777216) is required for " +
-                         std::string(self.name()));
-    return static_cast<std::uint32_t>(depth);
-}
-
-using StreamedPin =
-    std::variant<std::unique_ptr<hal::Out<bool>>, std::unique_ptr<hal::Out<double>>,
-                 std::unique_ptr<hal::Out<std::int32_t>>, std::unique_ptr<hal::Out<std::uint32_t>>,
-                 std::unique_ptr<hal::Out<std::int64_t>>, std::unique_ptr<hal::Out<std::uint64_t>>>;
-
-template <class T>
-StreamedPin make_pin(hal::Instance* owner, const std::string& name) {
-    return std::make_unique<hal::Out<T>>(owner, name);
-}
-
-StreamedPin make_streamed_pin(hal::Instance* owner, hal::Type type, std::size_t column) {
-    const std::string name = "pin." + std::to_string(column);
-    switch (type) {
-        case hal::Type::Bit:
-            return make_pin<bool>(owner, name);
-        case hal::Type::Float:
-            return make_pin<double>(owner, name);
-        case hal::Type::S32:
-            return make_pin<std::int32_t>(owner, name);
-        case hal::Type::U32:
-            return make_pin<std::uint32_t>(owner, name);
-        case hal::Type::S64:
-            return make_pin<std::int64_t>(owner, name);
-        case hal::Type::U64:
-            return make_pin<std::uint64_t>(owner, name);
-    }
-    throw hal::Error("unknown field type");
-}
-
-template <class T>
-T value_as(const hal::Value& v) noexcept {
-    if constexpr (std::is_same_v<T, bool>)
-        return v.b;
-    else if constexpr (std::is_same_v<T, double>)
-        return v.f;
-    else if constexpr (std::is_same_v<T, std::int32_t>)
-        return v.s32;
-    else if constexpr (std::is_same_v<T, std::uint32_t>)
-        return v.u32;
-    else if constexpr (std::is_same_v<T, std::int64_t>)
-        return v.s64;
-    else
-        return v.u64;
-}
-
-template <class T>
-void write_pin(std::unique_ptr<hal::Out<T>>& pin, const hal::Value& v) noexcept {
-    pin->set(value_as<T>(v));
-}
-
 struct Streamer : hal::Instance {
-    hal::Stream stream{this, name(), streamer_layout(*this), streamer_depth(*this)};
+    hal::Stream stream{this, name(), stream_args::layout(*this), stream_args::depth(*this)};
     hal::Out<bool> empty{this, "empty", true};
     hal::In<bool> enable{this, "enable", true};
     hal::Out<std::int32_t> curr_depth{this, "curr-depth"};
@@ -102,12 +35,9 @@ struct Streamer : hal::Instance {
 
     Streamer() : record_(stream.fields()) {
         for (std::size_t i = 0; i < stream.fields(); ++i)
-            pins_.push_back(make_streamed_pin(this, stream.field_type(i), i));
-        // Like LinuxCNC, the function needs a floating-point thread only if a float is moved.
-        bool moves_float = false;
-        for (std::size_t i = 0; i < stream.fields(); ++i)
-            moves_float = moves_float || stream.field_type(i) == hal::Type::Float;
-        function<&Streamer::update>("", moves_float);
+            pins_.push_back(std::make_unique<hal::AnyPin>(this, "pin." + std::to_string(i),
+                                                          stream.field_type(i), hal::Dir::Out));
+        function<&Streamer::update>("", stream_args::moves_float(stream));
     }
 
     void update(hal::Period) noexcept {
@@ -118,8 +48,7 @@ struct Streamer : hal::Instance {
         empty = used == 0;
         if (enable && clocked()) {
             if (stream.pop(record_.data())) {
-                for (std::size_t i = 0; i < pins_.size(); ++i)
-                    std::visit([&](auto& pin) { write_pin(pin, record_[i]); }, pins_[i]);
+                for (std::size_t i = 0; i < pins_.size(); ++i) pins_[i]->set(record_[i]);
             } else {
                 underruns = underruns + 1;
             }
@@ -142,7 +71,7 @@ struct Streamer : hal::Instance {
         }
     }
 
-    std::vector<StreamedPin> pins_;
+    std::vector<std::unique_ptr<hal::AnyPin>> pins_;
     std::vector<hal::Value> record_;  // sized once here; the realtime path never allocates
     unsigned clock_history_ = 0;
 };

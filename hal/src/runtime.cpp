@@ -981,6 +981,15 @@ Value parse_or_throw(Type t, const std::string& text, const std::string& what) {
 }
 }  // namespace
 
+void Runtime::no_pin_or_param(const std::string& name) const {
+    auto candidates = names("pin");
+    auto params = names("param");
+    candidates.insert(candidates.end(), params.begin(), params.end());
+    auto near = nearest_name(name, candidates);
+    throw Error(fmt::format("pin or parameter '{}' does not exist{}", name,
+                            near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near)));
+}
+
 void Runtime::cmd_setp(const std::vector<std::string>& a, std::string& out) {
     auto name = resolve(a[0]);
     if (auto it = params_.find(name); it != params_.end()) {
@@ -997,12 +1006,7 @@ void Runtime::cmd_setp(const std::vector<std::string>& a, std::string& out) {
         own_value(*segment_, p) = parse_or_throw(p.type, a[1], p.name);
         return;
     }
-    auto candidates = names("pin");
-    auto params = names("param");
-    candidates.insert(candidates.end(), params.begin(), params.end());
-    auto near = nearest_name(a[0], candidates);
-    throw Error(fmt::format("pin or parameter '{}' does not exist{}", a[0],
-                            near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near)));
+    no_pin_or_param(a[0]);
 }
 
 void Runtime::cmd_getp(const std::vector<std::string>& a, std::string& out) {
@@ -1015,12 +1019,7 @@ void Runtime::cmd_getp(const std::vector<std::string>& a, std::string& out) {
         out += format_value(it->second->type, read_pin(*it->second)) + "\n";
         return;
     }
-    auto candidates = names("pin");
-    auto params = names("param");
-    candidates.insert(candidates.end(), params.begin(), params.end());
-    auto near = nearest_name(a[0], candidates);
-    throw Error(fmt::format("pin or parameter '{}' does not exist{}", a[0],
-                            near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near)));
+    no_pin_or_param(a[0]);
 }
 
 void Runtime::cmd_sets(const std::vector<std::string>& a, std::string& out) {

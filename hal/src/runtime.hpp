@@ -246,6 +246,7 @@ private:
     Funct& find_funct(const std::string& name) const;
     Thread& find_thread(const std::string& name) const;
     Component& find_component(const std::string& name) const;
+    [[noreturn]] void no_pin_or_param(const std::string& name) const;
     [[noreturn]] void not_found(std::string_view kind, const std::string& name,
                                 std::string_view candidates_kind) const;
 

@@ -199,6 +199,33 @@ private:
     mutable T* ptr_;
 };
 
+// A pin whose type is chosen at load time (sampler's and streamer's cfg=ffb): reads and
+// writes whole 8-byte Values; the field of the Value that matters is the one of type().
+class AnyPin {
+public:
+    AnyPin(Instance* owner, std::string_view name, Type type, Dir dir, Value initial = Value{})
+        : type_(type) {
+        initial.u64 = type == Type::Bit ? std::uint64_t{initial.b} : initial.u64;
+        ptr_ = detail::register_pin(*owner, name, type, dir, initial, &ptr_);
+    }
+    AnyPin(const AnyPin&) = delete;
+    AnyPin& operator=(const AnyPin&) = delete;
+    Type type() const noexcept { return type_; }
+    Value get() const noexcept {
+        Value v;
+        v.u64 = detail::load(static_cast<std::uint64_t*>(std::atomic_ref<void*>(ptr_).load(std::memory_order_relaxed)));
+        return v;
+    }
+    void set(Value v) noexcept {
+        if (type_ == Type::Bit) v.u64 = v.b ? 1 : 0;  // keep the slot's unused bytes zero
+        detail::store(static_cast<std::uint64_t*>(std::atomic_ref<void*>(ptr_).load(std::memory_order_relaxed)), v.u64);
+    }
+
+private:
+    Type type_;
+    mutable void* ptr_;
+};
+
 // A parameter: like a pin that can never be linked. RO params are written only by the
 // component (timing figures, counters); RW ones by setp as well.
 template <class T>

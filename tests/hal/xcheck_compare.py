@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
-# Checks this case's expected output against LinuxCNC 2.9's recording of the same HAL setup
-# (linuxcnc.txt: `halrun -f linuxcnc.hal` on LinuxCNC, one halsampler line per cycle, floats
-# with 6 decimals). Prints the worst difference per signal; exits 1 on any mismatch.
+# Checks a *-linuxcnc-xcheck case's expected output against LinuxCNC 2.9's recording of the
+# same HAL setup (linuxcnc.txt: `halrun -f linuxcnc.hal` on LinuxCNC, one halsampler line per
+# cycle, floats with 6 decimals). The case's `signals` file names the recorded columns, in
+# order. Prints the worst difference per signal; exits 1 on any mismatch.
+#   usage: tests/hal/xcheck_compare.py tests/hal/pid-linuxcnc-xcheck
 import os, sys
-here = os.path.dirname(os.path.abspath(__file__))
-signals = ['p0-output', 'p0-error', 'p0-errorI', 'p0-errorD', 'p0-commandD', 'p0-saturated', 'p1-output', 'p1-error', 'p1-errorI', 'p1-errorD', 'p1-commandD', 'p1-saturated']
+here = os.path.abspath(sys.argv[1])
+signals = open(os.path.join(here, 'signals')).read().split()
 ours = [l.strip() for l in open(os.path.join(here, 'expected')) if l.strip() and not l.startswith('exit ')]
 ref = [l.split() for l in open(os.path.join(here, 'linuxcnc.txt'))]
 value = lambda v: 1.0 if v == 'TRUE' else 0.0 if v == 'FALSE' else float(v)
