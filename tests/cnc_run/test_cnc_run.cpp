@@ -101,28 +101,37 @@ std::vector<std::vector<double>> csv_rows(const std::string& text, std::string& 
 
 const char* kPocketArgs = "configs/sim/mill.ini examples/pocket.ngc --sim-clock";
 
+// The pocket with a trace (t.csv) and a preview (p.svg) written into `dir`.
+std::string pocket_args_with_outputs(const fs::path& dir) {
+    return fmt::format("{} --trace '{}' --preview '{}'", kPocketArgs, (dir / "t.csv").string(),
+                       (dir / "p.svg").string());
+}
+
 // One run of the pocket with a trace, shared by the tests that only read its results.
 class PocketRun : public ::testing::Test {
   protected:
     static void SetUpTestSuite() {
         scratch_ = new ScratchDir;
-        result_ = new RunResult(run_cnc(
-            fmt::format("{} --trace '{}'", kPocketArgs, (scratch_->path() / "t.csv").string()),
-            scratch_->path()));
+        result_ =
+            new RunResult(run_cnc(pocket_args_with_outputs(scratch_->path()), scratch_->path()));
         trace_ = new std::string(slurp(scratch_->path() / "t.csv"));
+        svg_ = new std::string(slurp(scratch_->path() / "p.svg"));
     }
     static void TearDownTestSuite() {
         delete trace_;
+        delete svg_;
         delete result_;
         delete scratch_;
     }
     static ScratchDir* scratch_;
     static RunResult* result_;
     static std::string* trace_;
+    static std::string* svg_;
 };
 ScratchDir* PocketRun::scratch_ = nullptr;
 RunResult* PocketRun::result_ = nullptr;
 std::string* PocketRun::trace_ = nullptr;
+std::string* PocketRun::svg_ = nullptr;
 
 TEST_F(PocketRun, FinishesWithoutErrors) {
     EXPECT_EQ(result_->exit_code, 0) << result_->err;
@@ -225,14 +234,33 @@ TEST_F(PocketRun, PlainProgressLinesOncePerSecond) {
     EXPECT_EQ(result_->out.find('\r'), std::string::npos);
 }
 
+TEST_F(PocketRun, PreviewDrawsThreeViewsWithRapidsAndFeeds) {
+    ASSERT_EQ(svg_->rfind("<svg ", 0), 0u) << "not an SVG";
+    for (const char* label : {">XY (top)<", ">XZ (front)<", ">YZ (side)<"})
+        EXPECT_NE(svg_->find(label), std::string::npos) << label;
+    EXPECT_NE(svg_->find("<polyline class=\"feed\""), std::string::npos);
+    // The first move is the rapid from the machine origin, which is the low corner of the
+    // path's X and Y extents (0..60, 0..50): in the XY view (left edge 16 px, 12 px padding,
+    // bottom edge 40 + 300 px) that is (16 + 12, 340 - 12).
+    const auto first = svg_->find("<polyline ");
+    ASSERT_NE(first, std::string::npos);
+    const std::string rapid = "<polyline class=\"rapid\"";
+    EXPECT_EQ(svg_->compare(first, rapid.size(), rapid), 0);
+    EXPECT_NE(svg_->find("points=\"28.00,328.00 ", first), std::string::npos);
+    EXPECT_NE(result_->out.find("\npreview: "), std::string::npos);
+}
+
 TEST_F(PocketRun, OutputIsByteIdenticalAcrossRuns) {
     ScratchDir scratch;
-    const RunResult again =
-        run_cnc(fmt::format("{} --trace '{}'", kPocketArgs, (scratch.path() / "t.csv").string()),
-                scratch.path());
+    const RunResult again = run_cnc(pocket_args_with_outputs(scratch.path()), scratch.path());
     EXPECT_EQ(again.exit_code, 0);
-    EXPECT_EQ(again.out, result_->out);
+    // The last line names the preview file, which is in each run's own folder.
+    const auto without_preview_line = [](const std::string& out) {
+        return out.substr(0, out.rfind("preview: "));
+    };
+    EXPECT_EQ(without_preview_line(again.out), without_preview_line(result_->out));
     EXPECT_TRUE(slurp(scratch.path() / "t.csv") == *trace_) << "traces differ";
+    EXPECT_TRUE(slurp(scratch.path() / "p.svg") == *svg_) << "previews differ";
 }
 
 TEST(CncRunErrors, BadProgramNamesFileAndLineAndMovesNothing) {

@@ -14,6 +14,8 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -32,6 +34,8 @@
 #include "backends.hpp"
 #include "hal/ini.hpp"
 #include "hal/script.hpp"
+#include "interp/block.hpp"
+#include "preview.hpp"
 #include "runtime.hpp"
 #include "segment.hpp"
 
@@ -134,6 +138,7 @@ struct Config {
     double period_s = 0;
     std::string axis_letters;  // lower case, once each, in [TRAJ]COORDINATES order
     int program_lines = 0;
+    std::string dialect;  // [RS274NGC]DIALECT
 };
 
 int count_lines(const std::string& path) {
@@ -164,6 +169,7 @@ Config load_config(const RunOptions& o) {
             c.axis_letters += l;
     }
     c.program_lines = count_lines(o.program);
+    c.dialect = ini.get("RS274NGC", "DIALECT").value_or("ncstudio");
     return c;
 }
 
@@ -420,6 +426,16 @@ void arm_estop(Session& s) {
     s.exec({"sets", "estop-reset", "TRUE"});
 }
 
+// X, Y, Z of a sample (0 for an axis the machine lacks), for the preview.
+std::array<double, 3> xyz_of(const MachinePins& p, const Sample& s) {
+    std::array<double, 3> xyz{0, 0, 0};
+    for (int k = 0; k < 3; ++k) {
+        const auto at = p.letters.find("xyz"[k]);
+        if (at != std::string::npos) xyz[k] = s.axis_mm[at];
+    }
+    return xyz;
+}
+
 struct LoopResult {
     Outcome outcome = Outcome::Finished;
     std::string fault_text;
@@ -431,7 +447,7 @@ struct LoopResult {
 // servo period, or a poll interval of wall time) and returns the time since start.
 LoopResult watch(Session& session, const MachinePins& pins, const RunOptions& o,
                  const std::function<double()>& step, Stats& stats, Progress& progress,
-                 Trace* trace, const StopRequest& stop) {
+                 Trace* trace, Preview* preview, const StopRequest& stop) {
     LoopResult r;
     Sample& s = r.last;
     bool ever_enabled = false;
@@ -440,6 +456,7 @@ LoopResult watch(Session& session, const MachinePins& pins, const RunOptions& o,
         read_sample(pins, step(), s);
         ++r.samples;
         if (trace) trace->row(s);
+        if (preview) preview->add(xyz_of(pins, s), s.line);
         stats.add(s);
         progress.update(s.t_s, s.line);
         if (abort_at_s) {
@@ -542,6 +559,15 @@ int run_session(const RunOptions& o, const Config& c, Session& session, const St
     std::unique_ptr<Trace> trace;
     if (!o.trace_path.empty())
         trace = std::make_unique<Trace>(o.trace_path, pins.letters, pins.ferror.size());
+    std::unique_ptr<Preview> preview;
+    if (!o.preview_path.empty()) {
+        try {
+            preview = std::make_unique<Preview>(classify_lines(o.program, c.dialect));
+        } catch (const interp::Error& e) {
+            fmt::print(stderr, "{}\n", e.what());
+            return 1;
+        }
+    }
     try {
         session.exec({"start"});  // motion plans the program here: a bad one fails now
     } catch (const hal::Error& e) {
@@ -553,11 +579,21 @@ int run_session(const RunOptions& o, const Config& c, Session& session, const St
     Stats stats(pins.letters, pins.ferror.size(), o.sim_clock, c.period_s);
     Progress progress(c.program_lines, ::isatty(STDOUT_FILENO) == 1);
     const LoopResult r = watch(session, pins, o, make_clock(session, o, c.period_s), stats,
-                               progress, trace.get(), stop);
+                               progress, trace.get(), preview.get(), stop);
     progress.finish(r.last.t_s, r.outcome == Outcome::Finished);
     session.exec({"stop"});  // motion prints a late planner error here
     const std::string error = outcome_error(o, r);
     print_summary(o, c, pins, r, stats, error);
+    if (preview) {
+        try {
+            preview->write_svg(o.preview_path,
+                               fmt::format("{} on {}: {:.3f} s", o.program, o.ini, r.last.t_s));
+        } catch (const std::runtime_error& e) {
+            fmt::print(stderr, "{}\n", e.what());
+            return 1;
+        }
+        fmt::print("preview: {}\n", o.preview_path);
+    }
     if (error.empty()) return 0;
     fmt::print(stderr, "{}\n", error);
     return r.outcome == Outcome::Interrupted ? 130 : 1;
@@ -578,6 +614,15 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& o) {
     cmd->add_option("--trace", o.trace_path,
                     "CSV of t,line,axes,joints,vel: every servo cycle with --sim-clock, "
                     "every poll (5 ms) otherwise");
+    cmd->add_option("--preview", o.preview_path,
+                    "SVG picture of the path followed (XY, XZ, YZ views; feeds and rapids)")
+        ->check(CLI::Validator(
+            [](std::string& path) {
+                return path.size() > 4 && path.compare(path.size() - 4, 4, ".svg") == 0
+                           ? std::string{}
+                           : "--preview writes SVG: the file name must end in .svg";
+            },
+            "FILE.svg"));
     cmd->add_option("--timeout", o.timeout_s, "give up after this much motion time, s")
         ->check(CLI::PositiveNumber);
     return cmd;

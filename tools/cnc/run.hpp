@@ -13,7 +13,8 @@ namespace cncrun {
 struct RunOptions {
     std::string ini;
     std::string program;
-    std::string trace_path;  // empty: no trace
+    std::string trace_path;    // empty: no trace
+    std::string preview_path;  // empty: no picture
     bool sim_clock = false;
     double timeout_s = 3600;  // motion time (simulated under --sim-clock)
 };
