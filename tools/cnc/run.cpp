@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <pthread.h>
 #include <signal.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -68,6 +69,12 @@ class StopRequest {
     StopRequest(const StopRequest&) = delete;
     StopRequest& operator=(const StopRequest&) = delete;
     bool requested() const noexcept { return requested_.load(std::memory_order_relaxed); }
+    // The shared-memory segment to remove if a second request quits at once (a normal end
+    // removes it through the runtime). Set once, before the run starts.
+    void set_segment_on_quit(const std::string& shm_name) {
+        shm_name_ = shm_name;
+        segment_known_.store(true, std::memory_order_release);
+    }
 
   private:
     void wait() {
@@ -75,11 +82,15 @@ class StopRequest {
             int sig = 0;
             sigwait(&set_, &sig);
             if (sig == SIGUSR1) return;
-            if (requested_.exchange(true)) std::_Exit(130);
+            if (!requested_.exchange(true)) continue;
+            if (segment_known_.load(std::memory_order_acquire)) ::shm_unlink(shm_name_.c_str());
+            std::_Exit(130);
         }
     }
     sigset_t set_{};
     std::atomic<bool> requested_{false};
+    std::string shm_name_;
+    std::atomic<bool> segment_known_{false};
     std::thread waiter_;
 };
 
@@ -639,10 +650,11 @@ int run_program(const RunOptions& o) {
     // The config's motion loadrt line reads these (see halfiles/motion_xyz.hal).
     ::setenv("CNC_PROGRAM", o.program.c_str(), 1);
     ::setenv("CNC_SIM_LOCKSTEP", o.sim_clock ? "1" : "0", 1);
-    const StopRequest stop;  // before the runtime: its threads inherit the signal mask
+    StopRequest stop;  // before the runtime: its threads inherit the signal mask
     try {
         Session session(o.sim_clock);
         ::setenv("HAL_INSTANCE", session.runtime.paths().instance.c_str(), 1);  // loadusr children
+        stop.set_segment_on_quit(session.runtime.paths().shm_name);
         return run_session(o, c, session, stop);
     } catch (const hal::Error& e) {
         fmt::print(stderr, "{}\n", e.what());
