@@ -443,3 +443,35 @@ TEST(CncRunStop, SigtermAbortsWithAControlledStop) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(CncRunRealTime, TraceAndSummaryEqualTheSimulatedClocks) {
+    // In real time a sampler stream records every servo cycle. The program fits in motion's
+    // queue, so it is fully planned before the first cycle, and a late cycle is skipped, not
+    // replayed: the commanded path per cycle is the same as under --sim-clock.
+    ScratchDir scratch;
+    const fs::path prog = scratch.path() / "square.ngc";
+    std::ofstream(prog) << "G90 G21\nG01 X10 F600\nG01 Y10\nM30\n";
+    std::string outs[2], traces[2];
+    for (int i = 0; i < 2; ++i) {
+        const fs::path csv = scratch.path() / fmt::format("t{}.csv", i);
+        const RunResult r =
+            run_cnc(fmt::format("configs/sim/mill.ini '{}' --trace '{}' {}", prog.string(),
+                                csv.string(), i == 0 ? "--sim-clock" : ""),
+                    scratch.path());
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        outs[i] = r.out;
+        traces[i] = slurp(csv);
+    }
+    EXPECT_TRUE(traces[0] == traces[1]) << "traces differ";
+    const auto pos = outs[0].find("clock: simulated");
+    ASSERT_NE(pos, std::string::npos);
+    EXPECT_EQ(outs[0].replace(pos, 16, "clock: real time"), outs[1]);
+    // 10 mm + 10 mm at F600 (10 mm/s) with a stop at the corner: a little over 2 s.
+    const double t = summary_number(outs[1], "motion time");
+    EXPECT_GT(t, 2.0);
+    EXPECT_LT(t, 2.5);
+}
+
+}  // namespace

@@ -3,9 +3,9 @@
 // CNC_PROGRAM, which the config's `loadrt motion program=$(CNC_PROGRAM)` reads), starts the
 // threads and watches motion's pins until the program ends, a fault, a timeout or Ctrl-C.
 //
-// Two clocks: the real one (the HAL threads run on their own; this loop polls the pins every
-// few milliseconds) and --sim-clock (this loop advances the simulated clock one servo period
-// at a time and sees every cycle, so the output is the same on every run).
+// Two clocks: the real one (the HAL threads run on their own; a sampler stream hands this loop
+// every cycle's pins) and --sim-clock (this loop advances the simulated clock one servo period
+// at a time and reads the pins, so the output is the same on every run).
 #include "run.hpp"
 
 #include <fmt/format.h>
@@ -26,8 +26,10 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -37,6 +39,7 @@
 #include "hal/script.hpp"
 #include "interp/block.hpp"
 #include "preview.hpp"
+#include "ring.hpp"
 #include "runtime.hpp"
 #include "segment.hpp"
 
@@ -457,14 +460,14 @@ struct LoopResult {
 // Steps the clock until the program ends or something stops it. `step` moves time on (one
 // servo period, or a poll interval of wall time) and returns the time since start.
 LoopResult watch(Session& session, const MachinePins& pins, const RunOptions& o,
-                 const std::function<double()>& step, Stats& stats, Progress& progress,
+                 const std::function<void(Sample&)>& next, Stats& stats, Progress& progress,
                  Trace* trace, Preview* preview, const StopRequest& stop) {
     LoopResult r;
     Sample& s = r.last;
     bool ever_enabled = false;
     std::optional<double> abort_at_s;
     for (;;) {
-        read_sample(pins, step(), s);
+        next(s);
         ++r.samples;
         if (trace) trace->row(s);
         if (preview) preview->add(xyz_of(pins, s), s.line);
@@ -501,21 +504,135 @@ LoopResult watch(Session& session, const MachinePins& pins, const RunOptions& o,
     }
 }
 
-std::function<double()> make_clock(Session& session, const RunOptions& o, double period_s) {
+// Every servo cycle in real time: a `sampler` instance added last to the servo thread copies
+// the watched pins into a stream each cycle, and the loop drains it every few milliseconds.
+class CycleStream {
+  public:
+    // nullptr when the config cannot be sampled this way (no servo thread to join, or more
+    // pins than a stream record holds); the caller then polls the pins instead.
+    static std::unique_ptr<CycleStream> attach(Session& s, const MachinePins& p, double period_s) {
+        std::vector<std::string> names{"motion.program-line"};
+        std::string cfg = "s";
+        for (char l : p.letters) names.push_back(fmt::format("axis.{}.pos-cmd", l));
+        for (std::size_t j = 0; j < p.joint_fb.size(); ++j)
+            names.push_back(fmt::format("joint.{}.motor-pos-fb", j));
+        for (std::size_t j = 0; j < p.ferror.size(); ++j)
+            names.push_back(fmt::format("joint.{}.f-error", j));
+        names.push_back("motion.current-vel");
+        cfg += std::string(names.size() - 1, 'f');
+        for (const char* bit : {"motion.in-position", "motion.fault", "motion.enable"}) {
+            names.push_back(bit);
+            cfg += 'b';
+        }
+        const std::string thread = servo_thread(s);
+        if (thread.empty() || names.size() > hal::kMaxStreamFields) return nullptr;
+        s.exec({"loadrt", "sampler", "names=" + std::string(kName), "cfg=" + cfg,
+                fmt::format("depth={}", kDepth)});
+        for (std::size_t i = 0; i < names.size(); ++i) {
+            const std::string input = fmt::format("{}.pin.{}", kName, i);
+            const std::string sig = signal_of(s, names[i]);
+            if (sig.empty())
+                s.exec({"net", fmt::format("{}-{}", kName, i), names[i], input});
+            else
+                s.exec({"net", sig, input});
+        }
+        s.exec({"addf", kName, thread});  // last: samples what this cycle produced
+        auto* ring = s.runtime.segment().at<hal::Ring>(s.runtime.stream_offset(kName));
+        return std::unique_ptr<CycleStream>(new CycleStream(ring, p, period_s));
+    }
+
+    // Waits for the next cycle's record. Throws hal::Error when the thread stops producing.
+    void next(Sample& s) {
+        const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(2);
+        while (!ring_->pop(record_.data())) {
+            if (std::chrono::steady_clock::now() > deadline)
+                throw hal::Error("the servo thread stopped running (no cycle for 2 s)");
+            std::this_thread::sleep_for(std::chrono::duration<double>(kPollPeriodS));
+        }
+        s.t_s = static_cast<double>(++cycles_) * period_s_;
+        std::size_t f = 0;
+        s.line = record_[f++].s32;
+        s.axis_mm.resize(axes_);
+        for (double& v : s.axis_mm) v = record_[f++].f;
+        s.joint_fb_mm.resize(joints_);
+        for (double& v : s.joint_fb_mm) v = record_[f++].f;
+        s.ferror_mm.resize(joints_);
+        for (double& v : s.ferror_mm) v = record_[f++].f;
+        s.vel_mm_s = record_[f++].f;
+        s.in_position = record_[f++].b;
+        s.fault = record_[f++].b;
+        s.enabled = record_[f++].b;
+    }
+
+    // Cycles lost because the loop fell more than the stream's depth behind.
+    std::uint64_t lost_cycles() const noexcept {
+        return ring_->overruns.load(std::memory_order_relaxed);
+    }
+
+  private:
+    static constexpr const char* kName = "cnc-run-sampler";
+    static constexpr int kDepth = 8192;  // cycles: 8 s at 1 kHz of slack for the loop
+
+    CycleStream(hal::Ring* ring, const MachinePins& p, double period_s)
+        : ring_(ring),
+          period_s_(period_s),
+          axes_(p.letters.size()),
+          joints_(p.ferror.size()),
+          record_(ring->fields) {}
+
+    // The thread motion-controller runs in: servo-thread by LinuxCNC's convention, or the
+    // only thread there is.
+    static std::string servo_thread(Session& s) {
+        const std::vector<std::string> threads = s.runtime.names("thread");
+        if (std::find(threads.begin(), threads.end(), "servo-thread") != threads.end())
+            return "servo-thread";
+        return threads.size() == 1 ? threads.front() : "";
+    }
+
+    // The signal a pin is on, or "" (`show pin` is the runtime's public view of the wiring).
+    static std::string signal_of(Session& s, const std::string& pin) {
+        std::string out;
+        s.runtime.execute({"show", "pin", pin}, out);
+        std::istringstream lines(out);
+        std::string line;
+        while (std::getline(lines, line)) {
+            std::istringstream words(line);
+            std::vector<std::string> w{std::istream_iterator<std::string>(words), {}};
+            if (w.size() >= 7 && w[4] == pin) return w[6];
+        }
+        return "";
+    }
+
+    hal::Ring* ring_;
+    double period_s_;
+    std::size_t axes_, joints_;
+    std::vector<hal::Value> record_;
+    long cycles_ = 0;
+};
+
+// How the loop gets its samples: under --sim-clock it advances the clock one servo period and
+// reads the pins; in real time it drains the cycle stream, or polls the pins every few
+// milliseconds when the config cannot be sampled per cycle.
+std::function<void(Sample&)> make_source(Session& session, const MachinePins& pins,
+                                         const RunOptions& o, double period_s,
+                                         CycleStream* stream) {
     if (o.sim_clock) {
         const std::string period = fmt::format("{:.9f}", period_s);
-        return [&session, period, period_s, cycles = 0L]() mutable {
+        return [&session, &pins, period, period_s, cycles = 0L](Sample& s) mutable {
             std::string out;
             session.runtime.execute({"advance", period}, out);
-            return static_cast<double>(++cycles) * period_s;
+            read_sample(pins, static_cast<double>(++cycles) * period_s, s);
         };
     }
+    if (stream) return [stream](Sample& s) { stream->next(s); };
     const auto start = std::chrono::steady_clock::now();
-    return [start, next = start]() mutable {
+    return [&pins, start, next = start](Sample& s) mutable {
         next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(
             std::chrono::duration<double>(kPollPeriodS));
         std::this_thread::sleep_until(next);
-        return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        read_sample(pins,
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+                    s);
     };
 }
 
@@ -579,20 +696,28 @@ int run_session(const RunOptions& o, const Config& c, Session& session, const St
             return 1;
         }
     }
+    // Real time: every cycle through a sampler stream (needs the sampler before start).
+    std::unique_ptr<CycleStream> stream;
+    if (!o.sim_clock) stream = CycleStream::attach(session, pins, c.period_s);
+    // Armed before start, so the latch sees the reset in the first cycle in real time as well.
+    arm_estop(session);
     try {
         session.exec({"start"});  // motion plans the program here: a bad one fails now
     } catch (const hal::Error& e) {
         fmt::print(stderr, "{}\n", e.what());
         return 1;
     }
-    arm_estop(session);
 
-    Stats stats(pins.letters, pins.ferror.size(), o.sim_clock, c.period_s);
+    Stats stats(pins.letters, pins.ferror.size(), o.sim_clock || stream, c.period_s);
     Progress progress(c.program_lines, ::isatty(STDOUT_FILENO) == 1);
-    const LoopResult r = watch(session, pins, o, make_clock(session, o, c.period_s), stats,
-                               progress, trace.get(), preview.get(), stop);
+    const LoopResult r =
+        watch(session, pins, o, make_source(session, pins, o, c.period_s, stream.get()), stats,
+              progress, trace.get(), preview.get(), stop);
     progress.finish(r.last.t_s, r.outcome == Outcome::Finished);
     session.exec({"stop"});  // motion prints a late planner error here
+    if (stream && stream->lost_cycles() > 0)
+        fmt::print(stderr, "warning: {} servo cycles were not sampled (this process fell behind)\n",
+                   stream->lost_cycles());
     const std::string error = outcome_error(o, r);
     print_summary(o, c, pins, r, stats, error);
     if (preview) {
@@ -623,8 +748,7 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& o) {
                   "simulated clock: as fast as the CPU allows, every servo cycle seen, "
                   "identical output on every run");
     cmd->add_option("--trace", o.trace_path,
-                    "CSV of t,line,axes,joints,vel: every servo cycle with --sim-clock, "
-                    "every poll (5 ms) otherwise");
+                    "CSV of t,line,axes,joints,vel, one row per servo cycle");
     cmd->add_option("--preview", o.preview_path,
                     "SVG picture of the path followed (XY, XZ, YZ views; feeds and rapids)")
         ->check(CLI::Validator(
