@@ -241,6 +241,23 @@ cycles::CycleWords BlockRun::cycle_words() const {
     return w;
 }
 
+// The cycle parameters of the machine, with the named-parameter settings (persisted or
+// configured) FIXEDCYCLE_BACK (δ of G73/G83, mm) and FIXEDCYCLE_OSS (G76/G87 shift direction)
+// taking precedence, so a public.dat or settings-file change reaches the built-in cycles too.
+cycles::CycleConfig BlockRun::cycle_config() const {
+    cycles::CycleConfig c = cfg_.cycles;
+    auto setting = [&](std::string_view name) -> std::optional<double> {
+        if (auto it = settings().params.find(name); it != settings().params.end())
+            return it->second;
+        if (auto it = cfg_.machine_settings.find(name); it != cfg_.machine_settings.end())
+            return it->second;
+        return std::nullopt;
+    };
+    if (auto back = setting("FIXEDCYCLE_BACK")) c.retract_mm = *back;
+    if (auto oss = setting("FIXEDCYCLE_OSS")) c.oss_direction = static_cast<int>(*oss);
+    return c;
+}
+
 void BlockRun::run_cycle() {
     if (!st.feed.feed_set) require_feed("a canned cycle");
     std::optional<cycles::CycleCode> code;
@@ -248,7 +265,7 @@ void BlockRun::run_cycle() {
         code = cycles::cycle_code_from_g(*cycle_code_ / 10);
     try {
         const cycles::Expansion e =
-            st.cycle.run_block(code, cycle_words(), cycle_context(), cfg_.cycles);
+            st.cycle.run_block(code, cycle_words(), cycle_context(), cycle_config());
         emit_cycle_steps(e);
     } catch (const cycles::CycleError& e) {
         fail(cycle_code_ ? loc_g(*cycle_code_) : b_.loc, e.what());
@@ -269,7 +286,7 @@ void BlockRun::run_hole_pattern() {
         const auto holes =
             cycles::hole_pattern(code / 10, w, st.motion.incremental,
                                  {st.pos.prog_mm[0], st.pos.prog_mm[1]}, st.cycle.active());
-        emit_cycle_steps(st.cycle.drill_at(holes, cycle_context(), cfg_.cycles));
+        emit_cycle_steps(st.cycle.drill_at(holes, cycle_context(), cycle_config()));
     } catch (const cycles::CycleError& e) {
         fail(loc_g(code), e.what());
     }

@@ -178,6 +178,7 @@ class BlockRun {
     void program_end(bool rewind);
     cycles::BlockContext cycle_context() const;
     cycles::CycleWords cycle_words() const;
+    cycles::CycleConfig cycle_config() const;
     void run_cycle();
     void run_hole_pattern();
     void emit_cycle_steps(const cycles::Expansion& e);
