@@ -363,14 +363,18 @@ TEST(FiveAxis, RotaryMovesEndAtTheProgrammedAngles) {
 
 namespace {
 
-// mill.ini with every [JOINT_N]FERROR lowered to 0.05 mm and the HAL files by absolute path.
-std::string mill_ini_with_tight_ferror() {
+// mill.ini with the HAL files by absolute path and `key` set to `value` in `section` (every
+// section when empty).
+std::string mill_ini_with(const std::string& section, const std::string& key,
+                          const std::string& value) {
     std::istringstream in(slurp(fs::path(CNC_SOURCE_DIR) / "configs/sim/mill.ini"));
-    std::string text, line;
+    std::string text, line, current;
     while (std::getline(in, line)) {
+        if (line.rfind('[', 0) == 0) current = line.substr(1, line.find(']') - 1);
         if (line.rfind("HALFILE = ", 0) == 0)
             line = fmt::format("HALFILE = {}/configs/sim/{}", CNC_SOURCE_DIR, line.substr(10));
-        if (line.rfind("FERROR = ", 0) == 0) line = "FERROR = 0.05";
+        if (line.rfind(key + " = ", 0) == 0 && (section.empty() || section == current))
+            line = key + " = " + value;
         text += line + "\n";
     }
     return text;
@@ -379,7 +383,7 @@ std::string mill_ini_with_tight_ferror() {
 TEST(CncRunErrors, FollowingErrorTripNamesLineAndJoint) {
     ScratchDir scratch;
     const fs::path ini = scratch.path() / "tight.ini";
-    std::ofstream(ini) << mill_ini_with_tight_ferror();
+    std::ofstream(ini) << mill_ini_with("", "FERROR", "0.05");
     const RunResult r =
         run_cnc(fmt::format("'{}' examples/pocket.ngc --sim-clock", ini.string()), scratch.path());
     EXPECT_EQ(r.exit_code, 1);
@@ -472,6 +476,28 @@ TEST(CncRunRealTime, TraceAndSummaryEqualTheSimulatedClocks) {
     const double t = summary_number(outs[1], "motion time");
     EXPECT_GT(t, 2.0);
     EXPECT_LT(t, 2.5);
+}
+
+TEST(CncRunErrors, DriveOverSpeedTripsTheEStop) {
+    // X's simulated drive trips above 50 mm/s (SIM_MAX_VEL): X passes that on the first rapid
+    // (line 4, X25 Y20, on its way to 100 mm/s); the drive fault trips the e-stop latch, which
+    // disables motion.
+    ScratchDir scratch;
+    const fs::path ini = scratch.path() / "slow.ini";
+    std::ofstream(ini) << mill_ini_with("JOINT_0", "SIM_MAX_VEL", "50");
+    const RunResult r =
+        run_cnc(fmt::format("'{}' examples/pocket.ngc --sim-clock", ini.string()), scratch.path());
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.err,
+              "examples/pocket.ngc:4: the machine was disabled during the program (e-stop: "
+              "motion.enable went FALSE); drive fault on joint 0 (amp-fault-in)\n");
+    // Stopped at once, not at the end of the rapid (25, 20): at about 50 mm/s X has moved
+    // v^2 / 2a = 50^2 / 2000 = 1.25 mm plus what the jerk limit adds, Y 4/5 of that.
+    const auto pos = summary_axes(r.out, "final position (mm)");
+    ASSERT_EQ(pos.size(), 3u) << r.out;
+    EXPECT_GT(pos[0], 1.0);
+    EXPECT_LT(pos[0], 3.0);
+    EXPECT_NEAR(pos[1], pos[0] * 20 / 25, 1e-3);
 }
 
 }  // namespace

@@ -395,9 +395,17 @@ class Trace {
 enum class Outcome { Finished, Fault, Disabled, NeverEnabled, Timeout, Interrupted };
 
 // Why motion faulted, from the joint pins of the faulting cycle.
-std::string describe_fault(const MachinePins& p, const Sample& s) {
-    for (std::size_t j = 0; j < p.ferror.size(); ++j) {
+// The first joint whose drive reports a fault, as text, or "". Read live: a drive whose
+// enable drops may clear its fault a cycle later, so this is best read at once.
+std::string drive_fault_text(const MachinePins& p) {
+    for (std::size_t j = 0; j < p.amp_fault.size(); ++j)
         if (p.amp_fault[j].bit()) return fmt::format("drive fault on joint {} (amp-fault-in)", j);
+    return "";
+}
+
+std::string describe_fault(const MachinePins& p, const Sample& s) {
+    if (std::string drive = drive_fault_text(p); !drive.empty()) return drive;
+    for (std::size_t j = 0; j < p.ferror.size(); ++j) {
         if (p.ferrored[j].bit())
             return fmt::format("following error on joint {}: {:.4f} mm, over its limit {} mm", j,
                                s.ferror_mm[j], p.ferror_limit[j].number());
@@ -485,6 +493,7 @@ LoopResult watch(Session& session, const MachinePins& pins, const RunOptions& o,
         ever_enabled = ever_enabled || s.enabled;
         if (ever_enabled && !s.enabled) {
             r.outcome = Outcome::Disabled;
+            r.fault_text = drive_fault_text(pins);  // what tripped the e-stop, if a drive did
             return r;
         }
         if (!ever_enabled && s.t_s >= kEnableGraceS) {
@@ -647,8 +656,8 @@ std::string outcome_error(const RunOptions& o, const LoopResult& r) {
         case Outcome::Disabled:
             return fmt::format(
                 "{}: the machine was disabled during the program (e-stop: motion.enable went "
-                "FALSE)",
-                where);
+                "FALSE){}",
+                where, r.fault_text.empty() ? "" : "; " + r.fault_text);
         case Outcome::NeverEnabled:
             return fmt::format(
                 "{}: the machine was never enabled (motion.enable stayed FALSE for {} s)", where,
