@@ -461,6 +461,7 @@ std::array<double, 3> xyz_of(const MachinePins& p, const Sample& s) {
 struct LoopResult {
     Outcome outcome = Outcome::Finished;
     std::string fault_text;
+    int fault_line = 0;  // the program line when the fault appeared
     Sample last;
     long samples = 0;
 };
@@ -485,10 +486,21 @@ LoopResult watch(Session& session, const MachinePins& pins, const RunOptions& o,
             if (s.in_position || s.t_s > *abort_at_s + kAbortGraceS) return r;
             continue;
         }
+        if (r.outcome == Outcome::Fault) {
+            // motion brings the machine to rest itself (a drive fault ramps the command down; a
+            // late planner error runs out what was planned): wait for that, within limits.
+            if (s.in_position || !s.enabled || s.t_s >= o.timeout_s) return r;
+            if (stop.requested() && !abort_at_s) {
+                abort_at_s = s.t_s;
+                session.exec({"setp", "motion.abort", "TRUE"});
+            }
+            continue;
+        }
         if (s.fault) {
             r.outcome = Outcome::Fault;
             r.fault_text = describe_fault(pins, s);
-            return r;
+            r.fault_line = s.line;
+            continue;
         }
         ever_enabled = ever_enabled || s.enabled;
         if (ever_enabled && !s.enabled) {
@@ -652,7 +664,7 @@ std::string outcome_error(const RunOptions& o, const LoopResult& r) {
         case Outcome::Finished:
             return "";
         case Outcome::Fault:
-            return fmt::format("{}: {}", where, r.fault_text);
+            return fmt::format("{}:{}: {}", o.program, r.fault_line, r.fault_text);
         case Outcome::Disabled:
             return fmt::format(
                 "{}: the machine was disabled during the program (e-stop: motion.enable went "
