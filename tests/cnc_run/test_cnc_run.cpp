@@ -500,4 +500,28 @@ TEST(CncRunErrors, DriveOverSpeedTripsTheEStop) {
     EXPECT_NEAR(pos[1], pos[0] * 20 / 25, 1e-3);
 }
 
+TEST(CncRunErrors, LatePlannerErrorRunsOutThePlannedMovesThenFails) {
+    // 10 000 short moves (more than motion's 4096-record queue), then a bad line: the error is
+    // found while the machine already runs. The moves before it still run out; the last good
+    // line (i = 9999) is X (9999 % 100) * 0.5 = 49.5, Y (9999 / 200) * 0.5 = 24.5.
+    ScratchDir scratch;
+    const fs::path prog = scratch.path() / "late.ngc";
+    {
+        std::ofstream out(prog);
+        out << "G90 G21\nG01 F6000\n";
+        for (int i = 0; i < 10000; ++i)
+            out << fmt::format("G01 X{:.3f} Y{:.3f}\n", (i % 100) * 0.5, (i / 200) * 0.5);
+        out << "G01 X10 Y#\nM30\n";
+    }
+    const RunResult r = run_cnc(fmt::format("configs/sim/mill.ini '{}' --sim-clock", prog.string()),
+                                scratch.path());
+    EXPECT_EQ(r.exit_code, 1);
+    // The bad line is 2 + 10000 + 1 = 10003; '#' is its 10th column.
+    EXPECT_NE(r.err.find(prog.string() + ":10003:10: "), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("motion fault"), std::string::npos) << r.err;
+    EXPECT_NE(r.out.find("\nfinal position (mm): x 49.5000  y 24.5000  z 0.0000\n"),
+              std::string::npos)
+        << r.out;
+}
+
 }  // namespace
