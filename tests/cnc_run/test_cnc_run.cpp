@@ -524,4 +524,33 @@ TEST(CncRunErrors, LatePlannerErrorRunsOutThePlannedMovesThenFails) {
         << r.out;
 }
 
+TEST(CncRunErrors, HalFileErrorNamesFileAndLine) {
+    ScratchDir scratch;
+    std::ofstream(scratch.path() / "bad.hal")
+        << "loadrt threads name1=servo-thread period1=1000000\nnet x-pos-cmd nosuch.pin\n";
+    std::ofstream(scratch.path() / "bad.ini")
+        << "[EMCMOT]\nSERVO_PERIOD = 1000000\n[HAL]\nHALFILE = bad.hal\n";
+    const RunResult r = run_cnc(
+        fmt::format("'{}' examples/pocket.ngc --sim-clock", (scratch.path() / "bad.ini").string()),
+        scratch.path());
+    EXPECT_EQ(r.exit_code, 1);
+    // HALFILE is relative to the INI's folder; the error is on its line 2.
+    EXPECT_EQ(r.err.rfind((scratch.path() / "bad.hal").string() + ":2: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find("nosuch.pin"), std::string::npos) << r.err;
+}
+
+TEST(CncRunErrors, ConfigWithoutMotionIsRefused) {
+    ScratchDir scratch;
+    std::ofstream(scratch.path() / "bare.hal")
+        << "loadrt threads name1=servo-thread period1=1000000\n";
+    const fs::path ini = scratch.path() / "bare.ini";
+    std::ofstream(ini) << "[EMCMOT]\nSERVO_PERIOD = 1000000\n[HAL]\nHALFILE = bare.hal\n";
+    const RunResult r =
+        run_cnc(fmt::format("'{}' examples/pocket.ngc --sim-clock", ini.string()), scratch.path());
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.err, ini.string() +
+                         ": the HAL files do not load the motion component (no pin "
+                         "motion.in-position)\n");
+}
+
 }  // namespace

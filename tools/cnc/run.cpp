@@ -195,10 +195,10 @@ struct MachinePins {
     std::vector<Probe> axis_cmd, ferror, ferror_limit, ferrored, amp_fault, joint_fb;
 };
 
-MachinePins find_pins(hal::Runtime& rt, const std::string& letters) {
+MachinePins find_pins(hal::Runtime& rt, const std::string& ini, const std::string& letters) {
     if (!try_probe(rt, "motion.in-position"))
-        throw hal::Error(
-            "the config's HAL files do not load the motion component (no pin motion.in-position)");
+        throw hal::Error(fmt::format(
+            "{}: the HAL files do not load the motion component (no pin motion.in-position)", ini));
     MachinePins p{Probe(rt, "motion.in-position"),
                   Probe(rt, "motion.fault"),
                   Probe(rt, "motion.enable"),
@@ -704,7 +704,7 @@ int run_session(const RunOptions& o, const Config& c, Session& session, const St
     session.script.load_ini(o.ini);
     for (const std::string& f : c.hal_files)
         if (!session.script.run_file(f)) return 1;  // run_file printed file:line: cause
-    const MachinePins pins = find_pins(session.runtime, c.axis_letters);
+    const MachinePins pins = find_pins(session.runtime, o.ini, c.axis_letters);
     std::unique_ptr<Trace> trace;
     if (!o.trace_path.empty())
         trace = std::make_unique<Trace>(o.trace_path, pins.letters, pins.ferror.size());
