@@ -7,9 +7,12 @@
 #     --lines N   program size: N lines / N arcs; the loop case makes 2N/5 calls (default 500000)
 #     --reps R    repetitions per measurement; best and median are printed (default 5)
 #     --build DIR build directory holding bin/cnc (default build/ at the repo root)
+#     --cnc PATH  the cnc executable itself (overrides --build)
 #     --keep      keep the generated programs (their directory is printed)
 #
-# Each case also runs at N/4 so peak RSS can be compared across program lengths.
+# Each case also runs at N/4 (both interpreters) so peak RSS can be compared across lengths.
+# Rates use the best wall time; the rate from the best user CPU time (GNU time, 1/100 s) is
+# printed beside it because on a shared machine user time varies less with load.
 # Exit 1 if a program fails to check (the figures would be meaningless); missing a target
 # only prints MISS.
 set -euo pipefail
@@ -17,6 +20,7 @@ root=$(cd "$(dirname "$0")/../.." && pwd)
 lines=500000
 reps=5
 build=$root/build
+cnc=
 use_linuxcnc=1
 keep=0
 rs274=/usr/bin/rs274
@@ -27,14 +31,15 @@ while [ $# -gt 0 ]; do
         --lines) lines=$2; shift 2 ;;
         --reps) reps=$2; shift 2 ;;
         --build) build=$2; shift 2 ;;
+        --cnc) cnc=$2; shift 2 ;;
         --no-linuxcnc) use_linuxcnc=0; shift ;;
         --keep) keep=1; shift ;;
-        -h|--help) sed -n '2,14p' "$0"; exit 0 ;;
+        -h|--help) sed -n '2,18p' "$0"; exit 0 ;;
         *) echo "run.sh: unknown argument '$1' (try --help)" >&2; exit 2 ;;
     esac
 done
 
-cnc=$build/bin/cnc
+[ -n "$cnc" ] || cnc=$build/bin/cnc
 [ -x "$cnc" ] || { echo "run.sh: $cnc not found; build it: cmake --build $build --target cnc" >&2; exit 2; }
 [ -x "$timer" ] || { echo "run.sh: $timer (GNU time) is needed for peak RSS" >&2; exit 2; }
 [[ $lines =~ ^[0-9]+$ ]] && [ "$lines" -ge 2000 ] || { echo "run.sh: --lines must be an integer >= 2000" >&2; exit 2; }
@@ -114,14 +119,15 @@ for kind in surfacing arcs loop; do
         read -r bw mw bu rss < <(measure "cnc check $kind" "$cnc" check "$prog.nc")
         check_moves "$kind-$size" "$units"
         ours=$(rate "$units" "$bw")
-        printf '%-9s %-24s cnc check: best %6.3f s median %6.3f s user %5.2f s  %8s %s/s [target >= %s: %s]  peak RSS %6.1f MB [<= 16 MB: %s]\n' \
-            "$kind" "$what" "$bw" "$mw" "$bu" "$(human "$ours")" "$unit" "$(human "$target")" \
+        printf '%-9s %-24s cnc check: best %6.3f s median %6.3f s user %5.2f s  %8s %s/s (user: %s) [target >= %s: %s]  peak RSS %6.1f MB [<= 16 MB: %s]\n' \
+            "$kind" "$what" "$bw" "$mw" "$bu" "$(human "$ours")" "$unit" "$(human "$(rate "$units" "$bu")")" "$(human "$target")" \
             "$(verdict "$ours" "$target" ge)" "$(awk -v k="$rss" 'BEGIN{print k/1024}')" "$(verdict "$rss" "$target_rss_kb" le)"
         eval "rss_${kind}_$size=$rss"
-        if [ "$use_linuxcnc" = 1 ] && [ "$size" = "$lines" ]; then
+        if [ "$use_linuxcnc" = 1 ]; then
             python3 "$gen" "$kind" "$count" linuxcnc "$prog.ngc"
             read -r tbw tmw tbu trss < <(measure "rs274 $kind" "$rs274" -g "$prog.ngc" /dev/null)
             theirs=$(rate "$units" "$tbw")
+            eval "trss_${kind}_$size=$trss"
             printf '%-9s %-24s rs274 -g:  best %6.3f s median %6.3f s user %5.2f s  %8s %s/s  peak RSS %6.1f MB   ours/theirs: speed %sx, RSS %sx\n' \
                 "" "" "$tbw" "$tmw" "$tbu" "$(human "$theirs")" "$unit" "$(awk -v k="$trss" 'BEGIN{print k/1024}')" \
                 "$(awk -v a="$tbw" -v b="$bw" 'BEGIN{ if (b <= 0) print "inf"; else printf "%.1f", a / b }')" \
@@ -130,7 +136,13 @@ for kind in surfacing arcs loop; do
         rm -f "$prog.nc" "$prog.ngc"
     done
     small=$(eval echo "\$rss_${kind}_$(( lines / 4 ))"); big=$(eval echo "\$rss_${kind}_$lines")
-    printf '%-9s peak RSS at N/4 %.1f MB, at N %.1f MB: growth %+d KB [flat (< 1 MB): %s]\n\n' "$kind" \
+    printf '%-9s peak RSS at N/4 %.1f MB, at N %.1f MB: growth %+d KB [flat (< 1 MB): %s]\n' "$kind" \
         "$(awk -v k="$small" 'BEGIN{print k/1024}')" "$(awk -v k="$big" 'BEGIN{print k/1024}')" \
         "$(( big - small ))" "$(verdict "$(( big - small ))" 1024 le)"
+    if [ "$use_linuxcnc" = 1 ]; then
+        small=$(eval echo "\$trss_${kind}_$(( lines / 4 ))"); big=$(eval echo "\$trss_${kind}_$lines")
+        printf '%-9s rs274 peak RSS at N/4 %.1f MB, at N %.1f MB: growth %+d KB\n' "" \
+            "$(awk -v k="$small" 'BEGIN{print k/1024}')" "$(awk -v k="$big" 'BEGIN{print k/1024}')" "$(( big - small ))"
+    fi
+    echo
 done
