@@ -15,6 +15,8 @@ packages=(
   libbenchmark-dev
   clang
   libclang-rt-14-dev
+  python3
+  time
 )
 missing=()
 for p in "${packages[@]}"; do
