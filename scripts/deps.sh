@@ -17,6 +17,7 @@ packages=(
   libclang-rt-14-dev
   python3
   time
+  procps
 )
 missing=()
 for p in "${packages[@]}"; do
