@@ -1,4 +1,5 @@
 #include "motion/planner.hpp"
+#include "root.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -312,24 +313,10 @@ double time_at(const Profile1D& p, double s) {
     double lo = 0, hi = (i + 1 < p.count ? p.phases[i + 1].t0_s : p.duration_s) - ph.t0_s;
     double flo = pos(lo), fhi = pos(hi);
     if (fhi <= 0) return ph.t0_s + hi;
-    int side = 0;
-    for (int k = 0; k < 100 && hi - lo > 1e-15; ++k) {
-        double x = (lo * fhi - hi * flo) / (fhi - flo);
-        if (!(x > lo && x < hi)) x = (lo + hi) / 2;
-        double f = pos(x);
-        if (f == 0) return ph.t0_s + x;
-        if (f < 0) {
-            lo = x, flo = f;
-            if (side == -1) fhi /= 2;
-            side = -1;
-        } else {
-            hi = x, fhi = f;
-            if (side == 1) flo /= 2;
-            side = 1;
-        }
-        if (std::fabs(f) < 1e-13 * std::max(1.0, s)) return ph.t0_s + x;
-    }
-    return ph.t0_s + (lo + hi) / 2;
+    const double tol = 1e-13 * std::max(1.0, s);
+    auto b = detail::illinois(pos, lo, flo, hi, fhi, 1e-15,
+                              [&](double, double f) { return std::fabs(f) < tol; });
+    return ph.t0_s + (b.lo + b.hi) / 2;
 }
 
 // The part of p between times ta and tb, shifted to start at time 0 and position 0.

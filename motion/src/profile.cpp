@@ -1,4 +1,5 @@
 #include "motion/profile.hpp"
+#include "root.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -75,23 +76,10 @@ double peak_speed_for_length(double length, double v_in, double v_out, double lo
     const double tol = 1e-12 * std::max(length, 1e-9);
     double flo = excess(lo), fhi = excess(hi);
     if (flo >= 0) return lo;
-    int side = 0;
-    for (int i = 0; i < 100 && hi - lo > 1e-14 * hi; ++i) {
-        double x = (lo * fhi - hi * flo) / (fhi - flo);
-        if (!(x > lo && x < hi)) x = (lo + hi) / 2;
-        double f = excess(x);
-        if (std::fabs(f) <= tol && f <= 0) return x;
-        if (f < 0) {
-            lo = x, flo = f;
-            if (side == -1) fhi /= 2;
-            side = -1;
-        } else {
-            hi = x, fhi = f;
-            if (side == 1) flo /= 2;
-            side = 1;
-        }
-    }
-    return lo;
+    // The answer must fit: accept only a point on the short side (excess <= 0).
+    auto b = detail::illinois(excess, lo, flo, hi, fhi, 1e-14 * hi,
+                              [&](double, double f) { return std::fabs(f) <= tol && f <= 0; });
+    return b.lo;
 }
 
 }  // namespace
