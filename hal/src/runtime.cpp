@@ -158,15 +158,15 @@ void* register_param(Instance& owner, std::string_view name, Type type, ParamDir
     return rt.segment_->at(slot);
 }
 
-void register_function(Instance& owner, std::string_view suffix, RealtimeFn fn, void* object,
-                       bool uses_fp) {
+void register_function(Instance& owner, std::string_view suffix, RealtimeFn fn, RealtimeBatchFn batch,
+                       void* object, bool uses_fp) {
     auto& ctx = context_of(owner, "function");
     Runtime& rt = *ctx.runtime;
     auto full = suffix.empty() ? ctx.name : qualified(ctx, suffix);
     if (rt.functs_.count(full)) throw Error(fmt::format("duplicate function '{}'", full));
     auto timing = ctx.building->allocate(sizeof(FunctTiming));
     rt.functs_[full] = std::make_unique<Funct>(
-        Funct{full, fn, object, uses_fp, ctx.component, {}, timing});
+        Funct{full, fn, batch, object, uses_fp, ctx.component, {}, timing});
     ctx.building->functs.push_back(full);
     for (auto [field, pname] : {std::pair{offsetof(FunctTiming, time_ns), "time"},
                                 std::pair{offsetof(FunctTiming, tmax_ns), "tmax"}}) {
@@ -194,8 +194,9 @@ void register_shared_function(Instance& owner, std::string_view name, RealtimeFn
     } else {
         comp.shared_functs.push_back(std::make_unique<SharedFunct>(SharedFunct{fn, {object}}));
         auto timing = ctx.building->allocate(sizeof(FunctTiming));
-        rt.functs_[full] = std::make_unique<Funct>(Funct{
-            full, &SharedFunct::call_all, comp.shared_functs.back().get(), uses_fp, &comp, {}, timing});
+        rt.functs_[full] = std::make_unique<Funct>(Funct{full, &SharedFunct::call_all, nullptr,
+                                                         comp.shared_functs.back().get(), uses_fp, &comp, {},
+                                                         timing});
         ctx.building->functs.push_back(full);
     }
     ctx.has_functions = true;

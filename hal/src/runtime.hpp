@@ -67,6 +67,7 @@ struct FunctTiming {
 struct Funct {
     std::string name;
     RealtimeFn fn;
+    RealtimeBatchFn batch;  // null: never grouped (shared functions already loop)
     void* object;
     bool uses_fp;
     Component* component;
@@ -186,7 +187,7 @@ public:
     friend struct LoadTransaction;
     friend void* detail::register_pin(Instance&, std::string_view, Type, Dir, Value, void*);
     friend void* detail::register_param(Instance&, std::string_view, Type, ParamDir, Value);
-    friend void detail::register_function(Instance&, std::string_view, RealtimeFn, void*, bool);
+    friend void detail::register_function(Instance&, std::string_view, RealtimeFn, RealtimeBatchFn, void*, bool);
     friend void detail::register_shared_function(Instance&, std::string_view, RealtimeFn, void*, bool);
     friend void* detail::register_stream(Instance&, std::string_view, std::string_view, std::uint32_t);
 

@@ -60,6 +60,20 @@ void Thread::set_functs(std::vector<Funct*> functs, const Segment& segment) {
     auto list = std::make_unique<List>();
     for (Funct* f : functs)
         list->entries.push_back({f->fn, f->object, segment.at<FunctTiming>(f->timing)});
+    // Group runs first (recording where each starts), then point them into the final array.
+    std::vector<std::size_t> starts;
+    for (std::size_t i = 0; i < functs.size(); ++i) {
+        Funct* f = functs[i];
+        bool extends = !list->runs.empty() && f->batch && list->runs.back().batch == f->batch;
+        if (extends) {
+            ++list->runs.back().count;
+        } else {
+            list->runs.push_back({f->fn, f->batch, nullptr, 1});
+            starts.push_back(list->objects.size());
+        }
+        list->objects.push_back(f->object);
+    }
+    for (std::size_t r = 0; r < list->runs.size(); ++r) list->runs[r].objects = list->objects.data() + starts[r];
     functs_ = std::move(functs);
     active_.store(list.get(), std::memory_order_release);
     lists_.push_back(std::move(list));
@@ -70,7 +84,10 @@ void Thread::run_functions(bool timed) noexcept {
     const List* list = active_.load(std::memory_order_acquire);
     const Period period = Period::from_ns(period_ns_);
     if (!timed) {
-        for (const Entry& e : list->entries) e.fn(e.object, period);
+        for (const Run& r : list->runs) {
+            if (r.count == 1) r.fn(r.objects[0], period);
+            else r.batch(r.objects, r.count, period);
+        }
         return;
     }
     std::int64_t t0 = monotonic_ns();

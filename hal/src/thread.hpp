@@ -73,8 +73,17 @@ private:
         void* object;
         struct FunctTiming* timing;
     };
+    // A run of consecutive entries calling the same batchable function: one call for all.
+    struct Run {
+        RealtimeFn fn;
+        RealtimeBatchFn batch;
+        void* const* objects;
+        std::size_t count;
+    };
     struct List {
-        std::vector<Entry> entries;
+        std::vector<Entry> entries;  // one per function, for timed cycles
+        std::vector<Run> runs;       // the same calls grouped, for every other cycle
+        std::vector<void*> objects;  // the runs' object arrays
     };
     void loop() noexcept;
     void run_functions(bool timed) noexcept;
