@@ -110,6 +110,45 @@ long Instance::arg_int(std::string_view key, long fallback) const {
     return x;
 }
 
+namespace {
+// Every instance allocation carries a 16-byte header saying where it came from, so delete
+// needs no runtime: arena memory is released with the runtime, heap memory at once.
+constexpr std::size_t kInstanceHeader = 16;
+}  // namespace
+
+void* Runtime::Arena::allocate(std::size_t bytes) {
+    bytes = (bytes + 63) & ~std::size_t{63};  // whole cache lines: no two instances share one
+    if (chunks.empty() || used + bytes > capacity) {
+        capacity = std::max<std::size_t>(bytes, 256 * 1024);
+        chunks.push_back(std::make_unique<std::byte[]>(capacity + 64));
+        used = 0;
+    }
+    auto base = reinterpret_cast<std::uintptr_t>(chunks.back().get());
+    auto aligned = (base + 63) & ~std::uintptr_t{63};
+    void* p = reinterpret_cast<void*>(aligned + used);
+    used += bytes;
+    return p;
+}
+
+void* Instance::operator new(std::size_t size) {
+    auto* ctx = detail::current_context();
+    std::byte* block;
+    if (ctx) {
+        // The header sits just before the object; the object starts on a cache line.
+        block = static_cast<std::byte*>(ctx->runtime->instance_arena_.allocate(size + 64)) + 64 - kInstanceHeader;
+    } else {
+        block = static_cast<std::byte*>(::operator new(size + kInstanceHeader));
+    }
+    *reinterpret_cast<bool*>(block) = ctx != nullptr;
+    return block + kInstanceHeader;
+}
+
+void Instance::operator delete(void* p) noexcept {
+    if (!p) return;
+    auto* block = static_cast<std::byte*>(p) - kInstanceHeader;
+    if (!*reinterpret_cast<bool*>(block)) ::operator delete(block);
+}
+
 void Instance::raise_fault() noexcept { fault_.store(true, std::memory_order_relaxed); }
 void Instance::clear_fault() noexcept { fault_.store(false, std::memory_order_relaxed); }
 bool Instance::faulted() const noexcept { return fault_.load(std::memory_order_relaxed); }

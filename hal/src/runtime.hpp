@@ -273,6 +273,16 @@ private:
     Value read_pin(const Pin& p) const;
     void set_instance_states(InstanceState state);
 
+    // Storage for instance objects (Instance::operator new), freed with the runtime.
+    struct Arena {
+        std::vector<std::unique_ptr<std::byte[]>> chunks;
+        std::size_t used = 0;      // bytes used in the last chunk
+        std::size_t capacity = 0;  // size of the last chunk
+        void* allocate(std::size_t bytes);
+    };
+    Arena instance_arena_;
+    friend class Instance;
+
     mutable std::recursive_mutex mutex_;
     InstancePaths paths_;
     std::unique_ptr<Segment> segment_;

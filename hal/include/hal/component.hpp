@@ -123,6 +123,11 @@ public:
     virtual void start() {}
     virtual void stop() {}
 
+    // Instances are packed into one arena per runtime, in load order, so a thread running a
+    // component's instances one after another walks contiguous memory.
+    static void* operator new(std::size_t size);
+    static void operator delete(void* p) noexcept;
+
     // Realtime-safe: moves the instance to the fault state (`show comp` shows it).
     void raise_fault() noexcept;
     void clear_fault() noexcept;
