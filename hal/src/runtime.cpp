@@ -358,6 +358,7 @@ void Runtime::shutdown() {
     running_ = false;
     set_instance_states(InstanceState::Stopped);
     while (!components_.empty()) unload_component(*components_.back());
+    instance_arena_ = Arena{};  // no instance is left in it
     threads_.clear();
     thread_order_.clear();
     signals_.clear();
