@@ -8,6 +8,7 @@
 #include <string>
 
 #include <fmt/format.h>
+#include <sys/mman.h>
 #include <unistd.h>
 
 #include "backends.hpp"
@@ -19,6 +20,9 @@ struct Harness {
     hal::Runtime runtime{{fmt::format("fuzz-{}", ::getpid()), 64u << 20, true}};
     hal::LocalBackend backend{runtime};
     hal::Script script{backend};
+    // Nothing attaches to this instance by name, and libFuzzer may leave with _Exit (no
+    // destructors): drop the name now so no segment outlives the process.
+    Harness() { ::shm_unlink(runtime.paths().shm_name.c_str()); }
 };
 
 bool allowed(const std::vector<std::string>& words) {
