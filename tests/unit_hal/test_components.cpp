@@ -89,7 +89,7 @@ HAL_COMPONENT(tstream, Streamer, "runtime test: stream producer")
 extern "C" __attribute__((visibility("default"))) const hal::ComponentDescriptor* cnc_hal_component() {
     static const char* const args[] = {nullptr};
     static const hal::ComponentDescriptor d{hal::kAbiVersion + 100, "tbadabi", "wrong ABI", args,
-                                            &hal::detail::create_instance<Probe>};
+                                            &hal::detail::create_instance<Probe>, {}};
     return &d;
 }
 #elif defined(TEST_COMPONENT_NOSYM)
