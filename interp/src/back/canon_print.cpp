@@ -258,14 +258,18 @@ void SummarySink::arc(const canon::Arc& a) {
     ++moves_;
     const double z0 = pos_[pa.normal];
     const double dz = a.end_mm[pa.normal] - z0;
+    // Quadrant points sit at exact multiples of 90 degrees: their cosines and sines need no
+    // trigonometry (which was a fifth of `cnc check`'s time on arc programs).
+    static constexpr double kCos[4] = {1, 0, -1, 0};
+    static constexpr double kSin[4] = {0, 1, 0, -1};
     for (int k = 0; k < 4 * (std::abs(a.turns) + 1); ++k) {
         const double q = k * std::numbers::pi / 2;  // angle of a quadrant point after the start
         double off = std::fmod(dir * (q - a0), two_pi);
         if (off < 0) off += two_pi;
         if (off > sweep) continue;
         std::array<double, 3> p{};
-        p[pa.first] = a.centre_mm[pa.first] + r * std::cos(q);
-        p[pa.second] = a.centre_mm[pa.second] + r * std::sin(q);
+        p[pa.first] = a.centre_mm[pa.first] + r * kCos[k % 4];
+        p[pa.second] = a.centre_mm[pa.second] + r * kSin[k % 4];
         p[pa.normal] = z0 + dz * off / sweep;
         extend(p);
     }
