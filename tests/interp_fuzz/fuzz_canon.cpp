@@ -8,13 +8,13 @@
 #include <string>
 #include <string_view>
 
+#include "fuzz_support.hpp"
 #include "interp/canon.hpp"
 #include "interp/executor.hpp"
 #include "interp/interpreter.hpp"
 
 namespace {
 
-constexpr int kMaxSteps = 2000;
 
 bool has_non_finite(std::string_view text) {
     for (std::string_view bad : {" nan", " -nan", " inf", " -inf", "=nan", "=inf", "=-inf"}) {
@@ -50,14 +50,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     try {
         Executor exec(sink, cfg);
         Interpreter in(exec, exec, options);
-        in.open(
-            Source::from_string("fuzz.nc", std::string(reinterpret_cast<const char*>(data), size)));
-        for (int steps = 0; steps < kMaxSteps; ++steps) {
-            try {
-                if (!in.step()) break;
-            } catch (const Error&) {
-            }
-        }
+        fuzz::run_input(in, data, size);
     } catch (const Error&) {
     }
     return 0;

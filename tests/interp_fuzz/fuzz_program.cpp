@@ -15,7 +15,6 @@ constexpr char kLibrary[] =
     "O686\n#FC50=#FIXEDCYCLE_BACK\nIF(!#FC13)G90 G65 P786\nIF(#FC13)G91 G65 P786 L=#FC11\nM17\n"
     "O786\nG00 X=#FC1 Y=#FC2\nG65 P886 L=INT(ABS(#FC4-#FC3) /ABS (#FC5)) -1\nM17\n"
     "O886\nG91 G00 Z=#FC50\nM17\n";
-constexpr int kMaxSteps = 2000;
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -28,14 +27,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     try {
         Interpreter in(exec, machine, options);
         in.set_library(Source::from_string("public.dat", kLibrary));
-        in.open(
-            Source::from_string("fuzz.nc", std::string(reinterpret_cast<const char*>(data), size)));
-        for (int steps = 0; steps < kMaxSteps; ++steps) {
-            try {
-                if (!in.step()) break;
-            } catch (const Error&) {
-            }
-        }
+        fuzz::run_input(in, data, size);
     } catch (const Error&) {
         // A program the source indexer rejects (duplicate labels) never starts.
     }

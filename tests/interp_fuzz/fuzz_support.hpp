@@ -4,9 +4,11 @@
 // else escaping — another exception, a crash, a sanitizer report — is a bug.
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <string_view>
 
 #include "interp/block.hpp"
+#include "interp/interpreter.hpp"
 
 namespace interp::fuzz {
 
@@ -33,5 +35,18 @@ class AcceptingExecutor : public BlockExecutor {
     void execute(const Block&) override { ++blocks; }
     void end_of_input(const SourceLoc&) override {}
 };
+
+// Opens the input as a program and steps it, as `cnc check` does: an error in one block is
+// reported and stepping goes on. The step cap keeps loops (M99, G65 L) from running forever.
+inline void run_input(Interpreter& in, const std::uint8_t* data, std::size_t size) {
+    constexpr int kMaxSteps = 2000;
+    in.open(Source::from_string("fuzz.nc", std::string(reinterpret_cast<const char*>(data), size)));
+    for (int steps = 0; steps < kMaxSteps; ++steps) {
+        try {
+            if (!in.step()) break;
+        } catch (const Error&) {
+        }
+    }
+}
 
 }  // namespace interp::fuzz
