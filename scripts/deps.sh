@@ -18,6 +18,8 @@ packages=(
   python3
   time
   procps
+  libcairo2-dev
+  libexpat1-dev
 )
 missing=()
 for p in "${packages[@]}"; do
