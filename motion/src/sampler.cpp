@@ -7,7 +7,26 @@
 namespace motion {
 namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// Single block: braking for a block's end starts when the deceleration that lands on it reaches
+// this share of the limit, leaving room for the speed the next period could still add.
+constexpr double kBlockBrakeShare = 0.8;
+
+bool is_action(const PreparedSegment& rec) noexcept {
+    return rec.action.kind != ActionKind::None;
+}
 }  // namespace
+
+PreparedSegment action_record(const AxisArray& pos_mm, const Action& action,
+                              std::int32_t line) noexcept {
+    PreparedSegment rec{};
+    rec.geom = make_line(pos_mm, pos_mm);
+    rec.profile.count = 1;         // one phase at rest, of zero duration
+    rec.phase_rate_cap.fill(1e9);  // nothing moves, so no rate can exceed a limit
+    rec.line = line;
+    rec.program_end = true;  // stands at rest: the queue may end here
+    rec.action = action;
+    return rec;
+}
 
 MotionSample sample(const PreparedSegment& seg, double t) noexcept {
     PathState ps = seg.profile.at(t);
@@ -82,8 +101,36 @@ void Sampler::abort() noexcept {
 void Sampler::clear_abort() noexcept {
     if (!status_.aborted) return;
     abort_ = false;
+    fault_ = false;
+    brake_ = Brake::None;
+    action_done_ = false;
+    block_released_ = false;
     status_.aborted = false;
     tau_ = 0;
+}
+
+void Sampler::fault_stop() noexcept {
+    abort_ = true;
+    fault_ = true;
+}
+
+void Sampler::set_single_block(bool on) noexcept {
+    single_block_ = on;
+}
+
+void Sampler::resume_block() noexcept {
+    if (!status_.block_paused) return;
+    block_released_ = true;
+    status_.block_paused = false;
+}
+
+const Action* Sampler::pending_action() const noexcept {
+    if (!status_.action_pending || ring_.size() == 0) return nullptr;
+    return &ring_.peek(0).action;
+}
+
+void Sampler::action_done() noexcept {
+    if (status_.action_pending) action_done_ = true;
 }
 
 double Sampler::rate_target() const noexcept {
@@ -192,20 +239,170 @@ RateLimits Sampler::rate_limits_now(double target, double dt) const noexcept {
     return {std::max(vm, rl_.max_rate_per_s), std::max(am, rl_.max_rate_per_s2)};
 }
 
+// At rest at the end of `cur` (the front record, finished), with a new block next.
+bool Sampler::pauses_at_block_end(const PreparedSegment& cur) const noexcept {
+    if (!single_block_ || block_released_ || ring_.size() < 2) return false;
+    if (ring_.peek(1).line == cur.line && !is_action(ring_.peek(1))) return false;
+    return r_ == 0 || cur.profile.at(cur.profile.duration_s).v_mm_s == 0;
+}
+
 void Sampler::consume_finished_records() noexcept {
     while (ring_.size() > 0) {
         const PreparedSegment& cur = ring_.peek(0);
+        if (is_action(cur) && !action_done_) {  // stand here until the owner has done it
+            tau_ = 0;
+            return;
+        }
         if (tau_ < cur.profile.duration_s) return;
-        if (ring_.size() == 1) {
+        if (ring_.size() == 1 || pauses_at_block_end(cur)) {
             tau_ = cur.profile.duration_s;
             return;
         }
+        if (ring_.peek(1).line != cur.line || is_action(ring_.peek(1))) block_released_ = false;
+        action_done_ = false;
         tau_ -= cur.profile.duration_s;
         ring_.pop();
     }
 }
 
+// The tangential deceleration that keeps every axis within its acceleration limit at path
+// speed u on this record (the centripetal part u^2 p'' taken off first), never below 5 % of it.
+double Sampler::decel_limit(const PreparedSegment& rec, double u) const noexcept {
+    const ElementBounds b = bounds(rec.geom);
+    double a = kInf, floor = kInf;
+    for (int k = 0; k < kAxes; ++k) {
+        if (b.g1[k] <= 1e-12) continue;
+        const double acc = cfg_.limits.acc_mm_s2[k];
+        a = std::min(a, (acc - u * u * b.g2[k]) / b.g1[k]);
+        floor = std::min(floor, 0.05 * acc / b.g1[k]);
+    }
+    if (!std::isfinite(floor)) return kInf;  // nothing moves on this record
+    return std::max(a, floor);
+}
+
+// Path length from s_mm in the front record to the end of the current block: the records that
+// follow with the same source line, up to an action or a program end (which end at rest).
+// *planned_stop tells whether the plan itself comes to rest there.
+double Sampler::block_remaining(double s_mm, bool* planned_stop) const noexcept {
+    const PreparedSegment* last = &ring_.peek(0);
+    double d = last->geom.length_mm - s_mm;
+    const std::size_t n = std::min(ring_.size(), cfg_.lookahead_records);
+    for (std::size_t i = 1; i < n && !last->program_end; ++i) {
+        const PreparedSegment& rec = ring_.peek(i);
+        if (rec.line != last->line || is_action(rec)) break;
+        d += rec.geom.length_mm;
+        last = &rec;
+    }
+    if (planned_stop) *planned_stop = last->profile.at(last->profile.duration_s).v_mm_s == 0;
+    return d;
+}
+
+void Sampler::land_at_block_end() noexcept {
+    const std::int32_t line = ring_.peek(0).line;
+    while (ring_.size() > 1 && !ring_.peek(0).program_end && ring_.peek(1).line == line &&
+           !is_action(ring_.peek(1)))
+        ring_.pop();
+    brake_s_mm_ = ring_.peek(0).geom.length_mm;
+}
+
+void Sampler::start_brake(Brake kind) noexcept {
+    if (brake_ != Brake::None) {  // a fault during a single-block stop keeps its state
+        brake_ = kind;
+        return;
+    }
+    if (ring_.size() == 0) return;
+    const PreparedSegment& cur = ring_.peek(0);
+    if (is_action(cur)) return;
+    const PathState ps = cur.profile.at(tau_);
+    const double u = ps.v_mm_s * r_;
+    if (!(u > 0)) return;  // at rest: the rate path stops it (nothing to brake)
+    brake_ = kind;
+    brake_s_mm_ = tau_ >= cur.profile.duration_s ? cur.geom.length_mm : ps.s_mm;
+    brake_u_mm_s_ = u;
+}
+
+// Single block: brake when the rest of the block is just long enough to stop in.
+void Sampler::check_block_end_brake() noexcept {
+    if (!single_block_ || brake_ != Brake::None || ring_.size() == 0) return;
+    const PreparedSegment& cur = ring_.peek(0);
+    if (is_action(cur)) return;
+    const PathState ps = cur.profile.at(tau_);
+    const double u = ps.v_mm_s * r_;
+    if (!(u > 0)) return;
+    const double s = tau_ >= cur.profile.duration_s ? cur.geom.length_mm : ps.s_mm;
+    bool planned_stop = false;
+    const double d = block_remaining(s, &planned_stop);
+    if (planned_stop) return;  // the plan ends the block at rest itself, within the jerk limit
+    if (u * u >= 2 * kBlockBrakeShare * decel_limit(cur, u) * d) start_brake(Brake::BlockEnd);
+}
+
+// One period of a braking stop: u falls at a constant deceleration (the limit for a fault, the
+// one that lands on the block's end for single block), the position is walked along the records.
+MotionSample Sampler::brake_step(double dt) noexcept {
+    const PreparedSegment* cur = &ring_.peek(0);
+    const double u = brake_u_mm_s_;
+    double decel = 0, left = kInf;
+    if (brake_ == Brake::BlockEnd) {
+        left = block_remaining(brake_s_mm_, nullptr);
+        decel = left > 0 ? u * u / (2 * left) : kInf;
+    } else {
+        decel = decel_limit(*cur, u);
+    }
+    const double t_stop = decel > 0 ? u / decel : kInf;
+    double u1 = t_stop <= dt ? 0.0 : u - decel * dt;
+    double ds = (u + u1) / 2 * std::min(dt, t_stop);  // exact for a constant deceleration
+    bool stopped = u1 <= 0;
+    if (brake_ == Brake::BlockEnd && (stopped || ds >= left)) {
+        land_at_block_end();
+        cur = &ring_.peek(0);
+        u1 = 0;
+        stopped = true;
+    } else {
+        double s = brake_s_mm_ + ds;
+        while (s > cur->geom.length_mm) {
+            if (ring_.size() == 1 || cur->program_end || is_action(ring_.peek(1))) {
+                s = cur->geom.length_mm;  // the queue ends here: nothing planned beyond
+                u1 = 0;
+                stopped = true;
+                break;
+            }
+            s -= cur->geom.length_mm;
+            ring_.pop();
+            cur = &ring_.peek(0);
+        }
+        brake_s_mm_ = s;
+    }
+    brake_u_mm_s_ = u1;
+    CurvePoint cp;
+    evaluate(cur->geom, brake_s_mm_, cp);
+    for (int k = 0; k < kAxes; ++k) {
+        last_.pos_mm[k] = cp.p[k];
+        last_.vel_mm_s[k] = u1 * cp.d1[k];
+        last_.acc_mm_s2[k] = stopped ? 0.0 : -decel * cp.d1[k] + u1 * u1 * cp.d2[k];
+        last_.jerk_mm_s3[k] = 0;
+    }
+    last_.line = cur->line;
+    status_.moving = !stopped;
+    status_.braking = !stopped;
+    status_.held = false;
+    status_.rate = 0;
+    status_.done = status_.starved = status_.action_pending = status_.block_paused = false;
+    if (stopped) {
+        r_ = rd_ = rdd_ = 0;
+        if (brake_ == Brake::Fault) {
+            status_.aborted = true;
+        } else {  // resume the planned profile from the block's end, at rate 0
+            tau_ = cur->profile.duration_s;
+            status_.block_paused = pauses_at_block_end(*cur);
+        }
+        brake_ = Brake::None;
+    }
+    return last_;
+}
+
 MotionSample Sampler::advance(double dt) noexcept {
+    if (fault_ && !status_.aborted && brake_ != Brake::Fault) start_brake(Brake::Fault);
+    if (brake_ != Brake::None) return brake_step(dt);
     if (status_.aborted) {  // discard until clear_abort()
         while (ring_.size() > 0) ring_.pop();
         last_.vel_mm_s = {};
@@ -216,11 +413,18 @@ MotionSample Sampler::advance(double dt) noexcept {
     if (ring_.size() == 0) {
         r_ = abort_ || hold_ ? 0 : std::min(override_, 1.0);  // the next record starts at rest
         rd_ = rdd_ = 0;
-        status_ = {false, false, false, hold_, abort_, r_};
+        status_ = {false, false, false, hold_, abort_, r_, false, false, false};
         if (abort_) status_.aborted = true;
         last_.vel_mm_s = {};
         last_.acc_mm_s2 = {};
         last_.jerk_mm_s3 = {};
+        return last_;
+    }
+    if (status_.block_paused && single_block_ && !block_released_ && !abort_) {
+        last_.vel_mm_s = {};  // stopped at a block's end: stay until resume_block()
+        last_.acc_mm_s2 = {};
+        last_.jerk_mm_s3 = {};
+        status_.moving = false;
         return last_;
     }
     double target = rate_target();
@@ -243,9 +447,13 @@ MotionSample Sampler::advance(double dt) noexcept {
         last_.jerk_mm_s3[k] = j * r_ * r_ * r_ + 3 * a * r_ * rd_ + v * rdd_;
     }
     last_.line = planned.line;
-    bool at_end = ring_.size() == 1 && tau_ >= cur.profile.duration_s;
-    status_.done = at_end && cur.program_end;
-    status_.starved = at_end && !cur.program_end;
+    status_.action_pending = is_action(cur) && !action_done_;
+    status_.block_paused =
+        !status_.action_pending && tau_ >= cur.profile.duration_s && pauses_at_block_end(cur);
+    bool at_end = status_.action_pending || status_.block_paused ||
+                  (ring_.size() == 1 && tau_ >= cur.profile.duration_s);
+    status_.done = at_end && cur.program_end && ring_.size() == 1 && !status_.action_pending;
+    status_.starved = at_end && !cur.program_end && !status_.block_paused;
     if (at_end) {  // nothing left to follow: the rate no longer moves anything
         last_.vel_mm_s = {};
         last_.acc_mm_s2 = {};
@@ -255,6 +463,8 @@ MotionSample Sampler::advance(double dt) noexcept {
     status_.held = hold_ && r_ == 0 && rd_ == 0;
     status_.aborted = abort_ && r_ == 0 && rd_ == 0;
     status_.rate = r_;
+    status_.braking = false;
+    if (!abort_) check_block_end_brake();
     return last_;
 }
 

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <thread>
+#include <vector>
 
 #include "motion/planner.hpp"
 #include "motion/sampler.hpp"
@@ -160,6 +161,165 @@ TEST(Sampler, AbortStopsAndDiscardsTheRestUntilCleared) {
     for (int i = 0; i < 10; ++i) EXPECT_EQ(rig.sampler.advance(1e-3).pos_mm, a.pos_mm);
     rig.sampler.clear_abort();
     EXPECT_FALSE(rig.sampler.status().aborted);
+}
+
+// Plans moves (one source line each, `stop_after` ending at rest) into a ring.
+void load(SpscRing<PreparedSegment>& ring, const PlannerConfig& cfg,
+          const std::vector<PathSegment>& moves) {
+    Planner p(cfg, {});
+    PreparedSegment r;
+    for (const PathSegment& m : moves) {
+        p.push(m);
+        while (p.pop(r)) ASSERT_TRUE(ring.try_push(r));
+    }
+    p.finish();
+    while (p.pop(r)) ASSERT_TRUE(ring.try_push(r));
+}
+
+PathSegment feed_to(double x, double feed, std::int32_t line) {
+    PathSegment s;
+    s.end_mm = {x};
+    s.feed_mm_s = feed;
+    s.line = line;
+    return s;
+}
+
+// A fault stop decelerates at the axis limit, jerk or not: from speed v it must be at rest within
+// v^2 / 2a (the ramp) plus one period of travel (the period in which the fault is seen).
+TEST(Sampler, FaultStopEndsWithinTheAccelerationDistance) {
+    for (double jerk : {0.0, 1e5, 1e4}) {
+        for (int trip_ms : {30, 45, 400}) {  // while accelerating (jerk phases) and cruising
+            Rig rig(uniform(100, 1000, jerk), 200, 50);
+            MotionSample s{};
+            for (int i = 0; i < trip_ms; ++i) s = rig.sampler.advance(1e-3);
+            const double v = s.vel_mm_s[0], x0 = s.pos_mm[0];
+            ASSERT_GT(v, 1) << "jerk " << jerk << " trip " << trip_ms;
+            rig.sampler.fault_stop();
+            double prev_v = v;
+            int n = 0;
+            while (!rig.sampler.status().aborted && n < 10000) {
+                s = rig.sampler.advance(1e-3);
+                EXPECT_LE(std::fabs(s.acc_mm_s2[0]), 1000 * (1 + 1e-9));
+                EXPECT_LE(s.vel_mm_s[0], prev_v + 1e-12);  // never speeds up
+                prev_v = s.vel_mm_s[0];
+                ++n;
+            }
+            ASSERT_TRUE(rig.sampler.status().aborted);
+            const double travel = s.pos_mm[0] - x0;
+            EXPECT_LE(travel, v * v / (2 * 1000) + v * 1e-3 + 1e-9)
+                << "jerk " << jerk << " trip " << trip_ms << " v " << v;
+            EXPECT_GE(travel, v * v / (2 * 1000) - 1e-9);  // and not shorter than the limit allows
+            EXPECT_EQ(s.vel_mm_s[0], 0);
+            MotionSample still = rig.sampler.advance(1e-3);
+            EXPECT_EQ(still.pos_mm, s.pos_mm);
+            EXPECT_EQ(rig.ring.size(), 0u);
+        }
+    }
+}
+
+TEST(Sampler, FaultStopOnADiagonalKeepsEachAxisWithinItsLimit) {
+    PlannerConfig cfg = uniform(100, 1000, 0);
+    cfg.limits.acc_mm_s2[1] = 250;  // Y is the weaker axis
+    SpscRing<PreparedSegment> ring(16);
+    Sampler sampler(sampler_config(cfg), ring, AxisArray{});
+    PathSegment diag;
+    diag.end_mm = {100, 100};
+    diag.feed_mm_s = 40;
+    load(ring, cfg, {diag});
+    for (int i = 0; i < 600; ++i) sampler.advance(1e-3);
+    sampler.fault_stop();
+    double max_ay = 0;
+    while (!sampler.status().aborted) {
+        MotionSample s = sampler.advance(1e-3);
+        max_ay = std::max(max_ay, std::fabs(s.acc_mm_s2[1]));
+        EXPECT_NEAR(s.pos_mm[0], s.pos_mm[1], 1e-9);  // stays on the path
+    }
+    // why: Y limits the path deceleration to 250 / sin 45 deg; Y itself reaches its 250.
+    EXPECT_NEAR(max_ay, 250, 1e-9);
+}
+
+TEST(Sampler, StandsOnAnActionUntilItIsDone) {
+    PlannerConfig cfg = uniform(100, 1000, 0);
+    SpscRing<PreparedSegment> ring(16);
+    Sampler sampler(sampler_config(cfg), ring, AxisArray{});
+    load(ring, cfg, {feed_to(10, 50, 1)});
+    Action out{ActionKind::SetOutput, true, 3, 0};
+    ASSERT_TRUE(ring.try_push(action_record(AxisArray{10}, out, 2)));
+    load(ring, cfg, {});  // nothing: the second move is planned from x = 10 below
+    Planner p(cfg, AxisArray{10});
+    p.push(feed_to(20, 50, 3));
+    p.finish();
+    PreparedSegment r;
+    while (p.pop(r)) ring.try_push(r);
+
+    int n = 0;
+    while (!sampler.pending_action() && n < 10000) {
+        sampler.advance(1e-3);
+        ++n;
+    }
+    ASSERT_NE(sampler.pending_action(), nullptr);
+    EXPECT_EQ(sampler.pending_action()->kind, ActionKind::SetOutput);
+    EXPECT_EQ(sampler.pending_action()->value, 3);
+    // why: 10 mm at 50 mm/s with 900 mm/s^2: 2/18 s ramps + (10 - 2.78) / 50 cruise = 0.2556 s.
+    EXPECT_NEAR(n * 1e-3, 0.2556, 1.5e-3);
+    for (int i = 0; i < 100; ++i) {
+        MotionSample s = sampler.advance(1e-3);
+        EXPECT_EQ(s.pos_mm[0], 10);
+        EXPECT_EQ(s.line, 2);
+        EXPECT_FALSE(sampler.status().done);
+        EXPECT_FALSE(sampler.status().moving);
+    }
+    sampler.action_done();
+    n = 0;
+    MotionSample s{};
+    while (!sampler.status().done && n < 10000) {
+        s = sampler.advance(1e-3);
+        ++n;
+    }
+    EXPECT_EQ(s.pos_mm[0], 20);
+    EXPECT_EQ(sampler.pending_action(), nullptr);
+    EXPECT_NEAR(n * 1e-3, 0.2556, 2.5e-3);
+}
+
+TEST(Sampler, SingleBlockStopsExactlyAtEachBlockEnd) {
+    for (double jerk : {0.0, 1e5}) {
+        PlannerConfig cfg = uniform(100, 1000, jerk);
+        SpscRing<PreparedSegment> ring(64);
+        Sampler sampler(sampler_config(cfg), ring, AxisArray{});
+        // Collinear moves: without single block the path runs through x = 20 and 40 at speed.
+        load(ring, cfg, {feed_to(20, 80, 1), feed_to(40, 80, 2), feed_to(60, 80, 3)});
+        sampler.set_single_block(true);
+        for (double block_end : {20.0, 40.0, 60.0}) {
+            int n = 0;
+            MotionSample s{};
+            while (!sampler.status().block_paused && !sampler.status().done && n < 10000) {
+                s = sampler.advance(1e-3);
+                EXPECT_LE(std::fabs(s.acc_mm_s2[0]), 1000 * (1 + 1e-9));
+                EXPECT_LE(s.pos_mm[0], block_end + 1e-9);
+                ++n;
+            }
+            EXPECT_EQ(s.pos_mm[0], block_end) << "jerk " << jerk;
+            EXPECT_EQ(s.vel_mm_s[0], 0);
+            for (int i = 0; i < 50; ++i) EXPECT_EQ(sampler.advance(1e-3).pos_mm[0], block_end);
+            sampler.resume_block();
+        }
+        EXPECT_TRUE(sampler.status().done);
+    }
+}
+
+TEST(Sampler, SingleBlockOffRunsThroughBlockEnds) {
+    PlannerConfig cfg = uniform(100, 1000, 0);
+    SpscRing<PreparedSegment> ring(64);
+    Sampler sampler(sampler_config(cfg), ring, AxisArray{});
+    load(ring, cfg, {feed_to(20, 80, 1), feed_to(40, 80, 2)});
+    double v_at_20 = 0;
+    for (int i = 0; i < 2000 && !sampler.status().done; ++i) {
+        MotionSample s = sampler.advance(1e-3);
+        if (std::fabs(s.pos_mm[0] - 20) < 0.1) v_at_20 = s.vel_mm_s[0];
+        EXPECT_FALSE(sampler.status().block_paused);
+    }
+    EXPECT_NEAR(v_at_20, 80, 1e-9);
+    EXPECT_TRUE(sampler.status().done);
 }
 
 TEST(Sampler, EmptyRingHoldsTheStartPosition) {

@@ -11,6 +11,30 @@
 
 namespace motion {
 
+// What a non-motion record asks of the machine. The sampler stands still on such a record (the
+// motion before it has ended at rest) until its owner reports the action carried out, so an
+// action happens exactly between the motion before it and the motion after it in program order.
+enum class ActionKind : std::uint8_t {
+    None,           // an ordinary motion (or dwell) record
+    SpindleSpeed,   // number = rpm (>= 0)
+    Spindle,        // value = 0 stop, 1 forward (M03), -1 reverse (M04)
+    SpindleOrient,  // number = angle in degrees
+    Coolant,        // flag = flood on (M08) / everything off (M09)
+    ToolChange,     // value = tool number: prepare, then change
+    SetToolNumber,  // value = tool number (M903): no handshake
+    SetOutput,      // value = digital output index, flag = level
+    WaitInput,      // value = digital input index, flag = level, number = timeout in s
+    Pause,          // M00
+    OptionalPause,  // M01: pauses only while the optional-stop switch is on
+};
+
+struct Action {
+    ActionKind kind = ActionKind::None;
+    bool flag = false;
+    std::int32_t value = 0;
+    double number = 0;
+};
+
 struct PreparedSegment {
     Element geom;
     Profile1D profile;  // s(t) over [0, profile.duration_s]
@@ -20,6 +44,7 @@ struct PreparedSegment {
     std::uint32_t seq = 0;     // running number, for diagnostics
     bool rapid = false;        // a traverse (G0): the rapid override applies, not the feed override
     bool program_end = false;  // the last record before the planner was told finish(): ends at rest
+    Action action;             // kind != None: a standing record of zero duration (see Action)
 };
 static_assert(std::is_trivially_copyable_v<PreparedSegment>,
               "PreparedSegment must be copyable through a lock-free ring");
@@ -35,5 +60,9 @@ struct MotionSample {
 // Samples one record at local time t_s (clamped to its duration), at planned speed.
 // Realtime-safe: noexcept, no allocation, bounded time.
 MotionSample sample(const PreparedSegment& seg, double t_s) noexcept;
+
+// A standing record that asks for `action` at pos_mm, tagged with the source line.
+PreparedSegment action_record(const AxisArray& pos_mm, const Action& action,
+                              std::int32_t line) noexcept;
 
 }  // namespace motion

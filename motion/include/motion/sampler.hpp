@@ -13,6 +13,14 @@
 // slowing down the bounds on r' and r'' grow as a r^2 and j r^3 shrink (rate_limits_now()), so a
 // hold from full speed takes a few tenths of a second rather than 1 / r'max.
 //
+// Two stops do not scale time but drive the path speed u directly, ignoring the jerk limit:
+// - fault_stop() (a drive fault, a limit switch, an e-stop) decelerates along the path at the
+//   full acceleration the axes allow (a line at a: stops within u^2 / 2a), then discards the
+//   queue like abort();
+// - single block: when the rest of the current block is just long enough to stop in at 80 % of
+//   that deceleration, u falls at the constant rate that lands exactly on the block's end.
+// Action records (prepared.hpp) are stood on until the owner calls action_done().
+//
 // Everything on this class is realtime-safe (noexcept, no allocation, bounded time) except
 // the constructor. One thread drives advance(); the controls may be called from the same thread.
 #pragma once
@@ -48,6 +56,9 @@ struct SamplerStatus {
     bool held = false;     // hold requested and the rate has reached 0
     bool aborted = false;  // abort requested and the rate has reached 0; queue being discarded
     double rate = 0;       // current time scale r
+    bool action_pending = false;  // standing on an action record not yet reported done
+    bool block_paused = false;    // single block: at rest at a block's end, until resume_block()
+    bool braking = false;         // a fault stop or a single-block stop is under way
 };
 
 class Sampler {
@@ -60,6 +71,16 @@ class Sampler {
     void abort() noexcept;
     // After an abort has stopped: accept records again (the owner resets the planner first).
     void clear_abort() noexcept;
+    // Abort with the shortest stop the acceleration limits allow (jerk ignored): for faults.
+    void fault_stop() noexcept;
+    // Single block: stop at the end of every block (a change of the records' source line).
+    void set_single_block(bool on) noexcept;
+    // Leaves a single-block pause: the next block runs.
+    void resume_block() noexcept;
+    // The action of the record being stood on, or null. Valid until the next advance().
+    const Action* pending_action() const noexcept;
+    // The owner has carried out the pending action: motion goes on with the next record.
+    void action_done() noexcept;
 
     // Advances wall time by dt_s and returns the commanded motion at the new time.
     MotionSample advance(double dt_s) noexcept;
@@ -73,6 +94,14 @@ class Sampler {
     double integrate_rate(double target, double dt, const RateLimits& lim) noexcept;
     RateLimits rate_limits_now(double target, double dt) const noexcept;
     void consume_finished_records() noexcept;
+    bool pauses_at_block_end(const PreparedSegment& cur) const noexcept;
+    enum class Brake : unsigned char { None, Fault, BlockEnd };
+    void start_brake(Brake kind) noexcept;
+    double decel_limit(const PreparedSegment& rec, double u) const noexcept;
+    double block_remaining(double s_mm, bool* planned_stop) const noexcept;
+    void land_at_block_end() noexcept;
+    MotionSample brake_step(double dt) noexcept;
+    void check_block_end_brake() noexcept;
 
     SamplerConfig cfg_;
     RateLimits rl_;           // fixed limits from the reserve
@@ -88,6 +117,13 @@ class Sampler {
     bool hold_ = false;
     bool abort_ = false;
     bool jerk_limited_ = false;
+    bool fault_ = false;
+    bool single_block_ = false;
+    bool block_released_ = false;  // resume_block() given at the current block end
+    bool action_done_ = false;     // for the action record at the front
+    Brake brake_ = Brake::None;
+    double brake_s_mm_ = 0;    // position within the front record while braking
+    double brake_u_mm_s_ = 0;  // path speed while braking
     SamplerStatus status_{};
 };
 
