@@ -8,12 +8,13 @@
 #include <cstdio>
 #include <ctime>
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "motion/planner.hpp"
 #include "motion/sampler.hpp"
-#include "ngc_bench_fixture.hpp"
+#include "ngc_program.hpp"
 
 namespace {
 
@@ -36,7 +37,7 @@ PlannerConfig config_for(const Settings& s, double jerk) {
     return cfg;
 }
 
-std::vector<PreparedSegment> plan_all(const PlannerConfig& cfg, const bench::FixtureProgram& prog) {
+std::vector<PreparedSegment> plan_all(const PlannerConfig& cfg, const bench::BenchProgram& prog) {
     Planner planner(cfg, prog.start_mm);
     std::vector<PreparedSegment> out;
     PreparedSegment rec;
@@ -49,7 +50,7 @@ std::vector<PreparedSegment> plan_all(const PlannerConfig& cfg, const bench::Fix
     return out;
 }
 
-double bound_s(const Settings& s, const bench::FixtureProgram& prog) {
+double bound_s(const Settings& s, const bench::BenchProgram& prog) {
     double t = 0;
     AxisArray pos = prog.start_mm;
     for (const PathSegment& seg : prog.segments) {
@@ -57,7 +58,7 @@ double bound_s(const Settings& s, const bench::FixtureProgram& prog) {
         t += bench::programmed_length_mm(seg, pos) / f;
         pos = seg.end_mm;
     }
-    return t;
+    return t + prog.dwell_s;
 }
 
 struct RunResult {
@@ -68,7 +69,7 @@ struct RunResult {
 };
 
 // Plays the plan through the realtime sampler at the servo period, as the servo thread would.
-RunResult run(const PlannerConfig& cfg, const bench::FixtureProgram& prog) {
+RunResult run(const PlannerConfig& cfg, const bench::BenchProgram& prog) {
     RunResult res;
     std::vector<PreparedSegment> recs = plan_all(cfg, prog);
     for (const auto& r : recs) res.planned_s += r.profile.duration_s;
@@ -85,7 +86,9 @@ RunResult run(const PlannerConfig& cfg, const bench::FixtureProgram& prog) {
             res.max_acc[k] = std::max(res.max_acc[k], std::fabs(ms.acc_mm_s2[k]));
         }
     } while (!sampler.status().done && periods < 100'000'000);
-    res.sampled_s = periods * cfg.servo_period_s;
+    // Dwells stand still for their time: the same on both sides of the ratio.
+    res.sampled_s = periods * cfg.servo_period_s + prog.dwell_s;
+    res.planned_s += prog.dwell_s;
     const AxisArray& end = prog.segments.back().end_mm;
     for (int k = 0; k < kAxes; ++k)
         res.end_error_mm = std::max(res.end_error_mm, std::fabs(ms.pos_mm[k] - end[k]));
@@ -93,7 +96,7 @@ RunResult run(const PlannerConfig& cfg, const bench::FixtureProgram& prog) {
 }
 
 // Lines where the plan spends the most time beyond length / min(F, vmax).
-void print_excess(const Settings& s, const PlannerConfig& cfg, const bench::FixtureProgram& prog,
+void print_excess(const Settings& s, const PlannerConfig& cfg, const bench::BenchProgram& prog,
                   int count) {
     std::vector<PreparedSegment> recs = plan_all(cfg, prog);
     std::map<int, double> spent, ideal;
@@ -119,7 +122,7 @@ double thread_cpu_s() {
 
 // Segments planned per second of this thread's CPU time (the machine may be shared, so wall
 // time would measure the neighbours too).
-double throughput_seg_s(const PlannerConfig& cfg, const bench::FixtureProgram& prog, double min_s) {
+double throughput_seg_s(const PlannerConfig& cfg, const bench::BenchProgram& prog, double min_s) {
     double t0 = thread_cpu_s();
     long segs = 0;
     double elapsed = 0;
@@ -140,71 +143,105 @@ double throughput_seg_s(const PlannerConfig& cfg, const bench::FixtureProgram& p
     return segs / elapsed;
 }
 
+struct Row {
+    std::string program;
+    double jerk = 0;
+    std::size_t segments = 0;
+    double bound_s = 0;
+    RunResult run;
+    double seg_per_s = 0;
+};
+
+void print_row_text(const Row& r, double base_s) {
+    std::string label = r.jerk > 0 ? fmt::format("jerk {:g} mm/s^3", r.jerk) : "jerk unlimited";
+    double motion_s = r.run.sampled_s;
+    fmt::print("{} {}: {} segments, motion time {:.3f} s (planned {:.4f} s), bound {:.3f} s, "
+               "ratio {:.4f}",
+               r.program, label, r.segments, motion_s, r.run.planned_s, r.bound_s,
+               motion_s / r.bound_s);
+    if (r.jerk > 0 && base_s > 0) fmt::print(", extra {:+.3f} s vs unlimited", motion_s - base_s);
+    fmt::print("\n  max |v| xyz {:.2f} {:.2f} {:.2f} mm/s, max |a| xyz {:.1f} {:.1f} {:.1f} mm/s^2, "
+               "end error {:.2e} mm",
+               r.run.max_vel[0], r.run.max_vel[1], r.run.max_vel[2], r.run.max_acc[0],
+               r.run.max_acc[1], r.run.max_acc[2], r.run.end_error_mm);
+    if (r.seg_per_s > 0) fmt::print(", planning {:.3g} segments per CPU second", r.seg_per_s);
+    fmt::print("\n");
+}
+
+void print_row_csv(const Row& r) {
+    fmt::print("{},{:g},{},{:.4f},{:.4f},{:.4f},{:.0f}\n", r.program, r.jerk, r.segments,
+               r.bound_s, r.run.sampled_s, r.run.sampled_s / r.bound_s, r.seg_per_s);
+}
+
+// The smoke run must at least end where the program ends, within the limits.
+bool within_limits(const Settings& s, const RunResult& r) {
+    bool ok = r.end_error_mm <= 1e-9;
+    for (int k = 0; k < kAxes; ++k)
+        ok = ok && r.max_vel[k] <= s.vel_mm_s * (1 + 1e-9) &&
+             r.max_acc[k] <= s.acc_mm_s2 * (1 + 1e-9);
+    return ok;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-    CLI::App app{"Motion planner benchmark (tp_default settings by default)"};
-    std::string program = MOTION_BENCH_DEFAULT_PROGRAM;
-    std::vector<double> jerks = {0, 100000, 20000};
+    CLI::App app{
+        "Motion planner benchmark: motion time against the bound sum(length / min(F, vmax)) and "
+        "planning throughput, for each program and each jerk limit"};
+    std::vector<std::string> programs;
+    std::vector<double> jerks;
     Settings s;
-    bool smoke = false;
+    bool smoke = false, csv = false;
     int excess = 0;
-    app.add_option("program", program, "G-code file (bench subset: G0-G3 G17 G21 G90 F)");
-    app.add_option("--jerk", jerks, "jerk limits to run, mm/s^3 (0 = unlimited)");
+    double min_cpu_s = 0.5;
+    app.add_option("programs", programs, "G-code files (default: tests/bench_motion/tp_default.ngc)");
+    app.add_option("--jerk", jerks, "jerk limit to run, mm/s^3 (0 = unlimited; repeatable)")
+        ->expected(1)
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+        ->delimiter(',');
+    app.add_flag("--csv", csv,
+                 "one row per (program, jerk): "
+                 "program,jerk_mm_s3,segments,bound_s,motion_s,ratio,plan_seg_per_s");
     app.add_option("--vel", s.vel_mm_s, "per-axis velocity limit, mm/s");
     app.add_option("--acc", s.acc_mm_s2, "per-axis acceleration limit, mm/s^2");
     app.add_option("--reserve", s.reserve, "share of acc/jerk kept for override and hold");
     app.add_option("--junction-share", s.junction_share,
                    "share of acc/jerk for non-smooth junctions");
-    app.add_option("--tolerance", s.tolerance_mm, "blend tolerance (G64 P), mm");
+    app.add_option("--tolerance", s.tolerance_mm,
+                   "blend tolerance (G64 P) for moves the program sets none for, mm");
     app.add_option("--excess", excess, "list the N lines with the most time over their bound");
-    app.add_flag("--smoke", smoke, "one quick pass, for ctest");
+    app.add_option("--min-cpu", min_cpu_s, "CPU seconds to spend measuring each throughput");
+    app.add_flag("--smoke", smoke, "one quick pass (jerk unlimited, no throughput), for ctest");
     CLI11_PARSE(app, argc, argv);
+    if (programs.empty()) programs.push_back(MOTION_BENCH_DEFAULT_PROGRAM);
+    if (jerks.empty() || smoke) jerks = {0};
 
     try {
-        bench::FixtureProgram prog = bench::read_ngc_fixture(program, s.tolerance_mm);
-        if (prog.segments.empty()) throw std::runtime_error(program + ": no moves");
-        double bound = bound_s(s, prog);
-        fmt::print("program {}: {} moves\n", program, prog.segments.size());
-        fmt::print(
-            "settings: {} mm/s, {} mm/s^2 per axis, servo {} Hz, G64 P{}, reserve {}, "
-            "junction share {}\n",
-            s.vel_mm_s, s.acc_mm_s2, 1 / s.period_s, s.tolerance_mm, s.reserve, s.junction_share);
-        fmt::print("bound sum(length / min(F, vmax)): {:.3f} s\n", bound);
-        double base = 0;
-        for (double j : jerks) {
-            PlannerConfig cfg = config_for(s, j);
-            RunResult r = run(cfg, prog);
-            if (j == 0) base = r.sampled_s;
-            std::string label = j > 0 ? fmt::format("jerk {:g} mm/s^3", j) : "jerk unlimited";
-            fmt::print("{}: motion time {:.3f} s (planned {:.4f} s), ratio {:.4f}", label,
-                       r.sampled_s, r.planned_s, r.sampled_s / bound);
-            if (j > 0 && base > 0) fmt::print(", extra {:+.3f} s vs unlimited", r.sampled_s - base);
-            fmt::print(
-                "\n  max |v| xyz {:.2f} {:.2f} {:.2f} mm/s, max |a| xyz {:.1f} {:.1f} {:.1f} "
-                "mm/s^2, end error {:.2e} mm\n",
-                r.max_vel[0], r.max_vel[1], r.max_vel[2], r.max_acc[0], r.max_acc[1], r.max_acc[2],
-                r.end_error_mm);
-            if (excess > 0) print_excess(s, cfg, prog, excess);
-            if (smoke) {
-                // The smoke run must at least end where the program ends, within the limits.
-                bool within = r.end_error_mm <= 1e-9;
-                for (int k = 0; k < kAxes; ++k)
-                    within = within && r.max_vel[k] <= s.vel_mm_s * (1 + 1e-9) &&
-                             r.max_acc[k] <= s.acc_mm_s2 * (1 + 1e-9);
-                if (!within) {
+        if (csv) fmt::print("program,jerk_mm_s3,segments,bound_s,motion_s,ratio,plan_seg_per_s\n");
+        else
+            fmt::print("settings: {} mm/s, {} mm/s^2 per axis, servo {} Hz, default G64 P{}, "
+                       "reserve {}, junction share {}\n",
+                       s.vel_mm_s, s.acc_mm_s2, 1 / s.period_s, s.tolerance_mm, s.reserve,
+                       s.junction_share);
+        for (const std::string& program : programs) {
+            bench::BenchProgram prog = bench::read_program(program, s.tolerance_mm);
+            if (prog.segments.empty()) throw std::runtime_error(program + ": no moves");
+            double base_s = 0;
+            for (double j : jerks) {
+                PlannerConfig cfg = config_for(s, j);
+                Row row{program, j, prog.segments.size(), bound_s(s, prog), run(cfg, prog), 0};
+                if (!smoke) row.seg_per_s = throughput_seg_s(cfg, prog, min_cpu_s);
+                if (j == 0) base_s = row.run.sampled_s;
+                if (csv)
+                    print_row_csv(row);
+                else
+                    print_row_text(row, base_s);
+                if (excess > 0 && !csv) print_excess(s, cfg, prog, excess);
+                if (smoke && !within_limits(s, row.run)) {
                     std::fprintf(stderr,
                                  "bench_motion: smoke run left the limits or the path end\n");
                     return 1;
                 }
-                break;
-            }
-        }
-        if (!smoke) {
-            for (double j : {0.0, jerks.back()}) {
-                double tp = throughput_seg_s(config_for(s, j), prog, 1.0);
-                fmt::print("planning throughput ({}): {:.3g} segments per CPU second\n",
-                           j > 0 ? fmt::format("jerk {:g}", j) : std::string("jerk unlimited"), tp);
             }
         }
     } catch (const std::exception& e) {
