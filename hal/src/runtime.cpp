@@ -262,6 +262,27 @@ void* register_stream(Instance& owner, std::string_view name, std::string_view l
     return ring;
 }
 
+void* attach_stream(Instance& owner, std::string_view name, std::string_view layout) {
+    auto& ctx = context_of(owner, "stream attachment");
+    Runtime& rt = *ctx.runtime;
+    const std::string full(name);
+    const auto it = rt.streams_.find(full);
+    if (it == rt.streams_.end()) {
+        std::vector<std::string> known;
+        for (const auto& [k, v] : rt.streams_) known.push_back(k);
+        const auto near = nearest_name(full, known);
+        throw Error(fmt::format("no stream '{}' to attach to (load its owner first){}", full,
+                                near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near)));
+    }
+    Type types[kMaxStreamFields];
+    const auto fields = parse_layout(layout, types);
+    auto* ring = rt.segment_->at<Ring>(it->second);
+    if (ring->fields != fields || !std::equal(types, types + fields, ring->types))
+        throw Error(fmt::format("stream '{}' has {} fields of another layout than '{}'", full,
+                                ring->fields, layout));
+    return ring;
+}
+
 bool registered_functions(const Instance& inst) noexcept {
     auto* ctx = current_context();
     return ctx && ctx->has_functions;
@@ -278,6 +299,9 @@ void SharedFunct::call_all(void* self, Period p) noexcept {
 
 Stream::Stream(Instance* owner, std::string_view name, std::string_view layout, std::uint32_t depth)
     : ring_(static_cast<Ring*>(detail::register_stream(*owner, name, layout, depth))) {}
+Stream Stream::attach(Instance* owner, std::string_view name, std::string_view layout) {
+    return Stream(static_cast<Ring*>(detail::attach_stream(*owner, name, layout)));
+}
 std::size_t Stream::fields() const noexcept { return ring_->fields; }
 Type Stream::field_type(std::size_t i) const noexcept { return ring_->types[i]; }
 bool Stream::push(const Value* record) noexcept { return ring_->push(record); }
@@ -780,6 +804,7 @@ void Runtime::load_component(const std::string& name, const std::vector<std::str
     }
     for (auto& m : made) comp->instances.push_back(std::move(m));
     comp->load_args.push_back(args);
+    comp->streams.insert(comp->streams.end(), building.streams.begin(), building.streams.end());
 }
 
 void Runtime::unload_component(Component& c) {
@@ -825,12 +850,7 @@ void Runtime::unload_component(Component& c) {
     }
     // Stream rings stay allocated until the instance ends: halsampler may still be draining
     // one, and a ring reused under it would hand it another stream's records.
-    for (auto it = streams_.begin(); it != streams_.end();) {
-        bool owned = false;
-        for (auto& inst : c.instances)
-            if (it->first.rfind(inst->name, 0) == 0) owned = true;
-        it = owned ? streams_.erase(it) : std::next(it);
-    }
+    for (const std::string& name : c.streams) streams_.erase(name);
     c.instances.clear();
     if (c.library) ::dlclose(c.library);
     auto pos = std::find_if(components_.begin(), components_.end(), [&](auto& p) { return p.get() == &c; });

@@ -121,6 +121,7 @@ struct Component {
     std::vector<std::unique_ptr<InstanceRecord>> instances;
     std::vector<std::unique_ptr<SharedFunct>> shared_functs;
     std::vector<std::vector<std::string>> load_args;  // each loadrt line's arguments, for save
+    std::vector<std::string> streams;  // names its instances registered (any name, not only prefixed)
     pid_t pid = 0;  // userspace: the process that owns it
     bool ready = false;
 };
@@ -190,6 +191,7 @@ public:
     friend void detail::register_function(Instance&, std::string_view, RealtimeFn, RealtimeBatchFn, void*, bool);
     friend void detail::register_shared_function(Instance&, std::string_view, RealtimeFn, void*, bool);
     friend void* detail::register_stream(Instance&, std::string_view, std::string_view, std::uint32_t);
+    friend void* detail::attach_stream(Instance&, std::string_view, std::string_view);
 
 private:
     using Handler = void (Runtime::*)(const std::vector<std::string>&, std::string&);

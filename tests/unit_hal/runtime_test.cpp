@@ -45,6 +45,32 @@ TEST_F(Rt, LoadrtErrorsNameTheProblem) {
     EXPECT_EQ(run("list comp"), "\n");
 }
 
+TEST_F(Rt, AComponentAttachesToAnotherInstancesStream) {
+    make();
+    run("loadrt tstream");
+    run("loadrt tstreamreader from=tstream.0");
+    run("newthread t 1000000");
+    run("addf tstream.0 t");
+    run("addf tstreamreader.0 t");
+    run("setp tstream.0.value 2.5");
+    run("start");
+    run("advance 0.003");
+    // Producer before consumer in the thread: each cycle's record is read in the same cycle.
+    EXPECT_EQ(run("getp tstreamreader.0.popped"), "3\n");
+    EXPECT_EQ(run("getp tstreamreader.0.value"), "2.5\n");
+    EXPECT_EQ(run("getp tstreamreader.0.flag"), "TRUE\n");  // the third record: n = 2 is even
+    EXPECT_NE(error_of("loadrt tstreamreader from=tstream.7").find("no stream 'tstream.7' to attach to"),
+              std::string::npos);
+    EXPECT_EQ(error_of("loadrt tstreamreader from=tstream.0 layout=ff"),
+              "loadrt tstreamreader: stream 'tstream.0' has 2 fields of another layout than 'ff'");
+    run("stop");
+    run("unload tstreamreader");
+    run("unload tstream");
+    // The owner's stream name is free again after unload.
+    run("loadrt tstream");
+    run("loadrt tstreamreader from=tstream.0");
+}
+
 TEST_F(Rt, AFailedConstructorLeavesNothingBehind) {
     make();
     auto before = rt->segment().bytes_in_use();

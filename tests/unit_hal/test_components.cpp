@@ -75,6 +75,23 @@ struct Streamer : hal::Instance {
     }
 };
 
+// The consumer end of another instance's stream (`from=NAME`), attached in-process.
+struct StreamReader : hal::Instance {
+    hal::Stream stream = hal::Stream::attach(this, arg("from").value_or(""),
+                                            arg("layout").value_or("fb"));
+    hal::Out<double> value{this, "value"};
+    hal::Out<bool> flag{this, "flag"};
+    hal::Out<std::int32_t> popped{this, "popped"};
+    std::int32_t n = 0;
+    void update(hal::Period) noexcept {
+        hal::Value rec[2];
+        if (!stream.pop(rec)) return;
+        value = rec[0].f;
+        flag = rec[1].b;
+        popped = ++n;
+    }
+};
+
 }  // namespace
 
 #if defined(TEST_COMPONENT_PROBE)
@@ -85,6 +102,9 @@ HAL_COMPONENT(tfailing, Failing, "runtime test: constructor failure", "fail-at")
 HAL_COMPONENT(tspinner, Spinner, "runtime test: late cycles")
 #elif defined(TEST_COMPONENT_STREAM)
 HAL_COMPONENT(tstream, Streamer, "runtime test: stream producer")
+#elif defined(TEST_COMPONENT_STREAMREADER)
+HAL_COMPONENT(tstreamreader, StreamReader, "runtime test: consumer of another instance's stream",
+              "from", "layout")
 #elif defined(TEST_COMPONENT_BADABI)
 extern "C" __attribute__((visibility("default"))) const hal::ComponentDescriptor* cnc_hal_component() {
     static const char* const args[] = {nullptr};

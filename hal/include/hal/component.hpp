@@ -56,6 +56,7 @@ void register_shared_function(Instance& owner, std::string_view name, RealtimeFn
                               void* object, bool uses_fp);
 void* register_stream(Instance& owner, std::string_view name, std::string_view layout,
                       std::uint32_t depth);
+void* attach_stream(Instance& owner, std::string_view name, std::string_view layout);
 InstanceContext* current_context();
 
 template <class C, auto Method>
@@ -306,6 +307,13 @@ std::string Array<P>::format_name(std::string_view pattern, std::size_t index) {
 class Stream {
 public:
     Stream(Instance* owner, std::string_view name, std::string_view layout, std::uint32_t depth);
+    // The other end of a stream that an instance loaded earlier registered, for a component
+    // that consumes (or produces) another's stream in-process: motion reading the interp
+    // component's canonical commands. Only from a constructor during loadrt; throws
+    // hal::Error when there is no such stream or its layout differs from `layout`. The ring
+    // stays valid after its owner is unloaded (rings live as long as the HAL instance); it
+    // just receives nothing more. Either end must still be used by one thread only.
+    static Stream attach(Instance* owner, std::string_view name, std::string_view layout);
     std::size_t fields() const noexcept;
     Type field_type(std::size_t i) const noexcept;
     // Realtime-safe. push() fails (and counts an overrun) when the ring is full; pop() fails
@@ -316,6 +324,7 @@ public:
     std::uint32_t used() const noexcept;
 
 private:
+    explicit Stream(struct Ring* ring) noexcept : ring_(ring) {}
     struct Ring* ring_;
 };
 
