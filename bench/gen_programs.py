@@ -33,7 +33,7 @@ def surface_3d():
     0.05 mm in XY with Z following the surface: 10 380 segments at F6000 (100 mm/s = vmax)."""
     step_mm, row_len_steps, rows, row_pitch_steps = 0.05, 500, 20, 20
     lines = ["(surface_3d.ngc: written by bench/gen_programs.py; 3D surface, 0.05 mm segments)",
-             HEADER, "G64 P0.01", "G0 Z1", f"G1 Z{fmt(surface_z_mm(0, 0))} F6000"]
+             HEADER, "G0 Z1", f"G1 Z{fmt(surface_z_mm(0, 0))} F6000"]
     x_i, y_i = 0, 0
 
     def move():
@@ -88,7 +88,7 @@ def tangent_arcs():
     joins the next tangentially (a serpentine). F2400 = 40 mm/s, above what centripetal
     acceleration allows on the 0.5 and 1 mm radii (sqrt(1000 * r) = 22.4, 31.6 mm/s)."""
     lines = ["(tangent_arcs.ngc: written by bench/gen_programs.py; small tangent arcs)",
-             HEADER, "G64 P0.01", "G0 Z1", "G1 Z0 F600", "F2400"]
+             HEADER, "G0 Z1", "G1 Z0 F600", "F2400"]
     x = 0.0
     radii = (0.5, 1.0, 1.5)
     for i in range(240):

@@ -35,7 +35,7 @@ status=0
 # HOME: linuxcnc copies its debug and print logs there when not on a terminal.
 (cd "$scratch" && HOME=$scratch linuxcnc bench.ini) >"$scratch"/log 2>&1 </dev/null || status=$?
 if [[ ! -s $scratch/result ]] || grep -q '^error=' "$scratch"/result; then
-    cat "$scratch"/result 2>/dev/null >&2 || true
+    sed "s/^error=/LinuxCNC: /" "$scratch"/result >&2 2>/dev/null || true
     echo "$0: LinuxCNC run failed (exit $status); its log:" >&2
     tail -n 30 "$scratch"/linuxcnc_print.txt "$scratch"/log >&2 2>/dev/null || true
     exit 1

@@ -1,0 +1,127 @@
+#!/usr/bin/env bash
+# Motion benchmark: for each program in bench/ (or the ones named), our planner's motion time
+# against the bound sum(length / min(F, vmax)) and against LinuxCNC 2.9 on the same settings
+# (100 mm/s, 1000 mm/s^2 per axis, 1 kHz servo, G64 P0.01 unless the program sets one, jerk
+# unlimited), planning throughput, and how much faster than real time `cnc run --sim-clock` ran.
+# See bench/README.md and docs/benchmarks.md ("Motion").
+#
+#   bench/run.sh [--build DIR] [--no-build] [--no-linuxcnc] [PROGRAM...]
+#   bench/run.sh --check      every bench program passes `cnc check`; generated ones up to date
+#
+# --build DIR    build folder (default build-bench/ at the repository root, configured Release
+#                and built here unless --no-build)
+# --no-linuxcnc  skip LinuxCNC (it is skipped anyway when not installed)
+set -euo pipefail
+
+bench_dir=$(cd "$(dirname "$0")" && pwd)
+root=$(cd "$bench_dir/.." && pwd)
+build=$root/build-bench
+do_build=1
+use_linuxcnc=1
+check_only=0
+programs=()
+while [[ $# -gt 0 ]]; do
+    case $1 in
+        --build) build=$(realpath "$2"); shift 2 ;;
+        --no-build) do_build=0; shift ;;
+        --no-linuxcnc) use_linuxcnc=0; shift ;;
+        --check) check_only=1; shift ;;
+        -h | --help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        -*) echo "$0: unknown option $1" >&2; exit 64 ;;
+        *) programs+=("$(realpath "$1")"); shift ;;
+    esac
+done
+if [[ ${#programs[@]} -eq 0 ]]; then
+    # Fixed order: the reference program, the generated stress programs, the seeds' parts.
+    programs=("$bench_dir"/tp_default.ngc "$bench_dir"/surface_3d.ngc
+        "$bench_dir"/pocket_sharp.ngc "$bench_dir"/tangent_arcs.ngc "$bench_dir"/seed_*.ngc)
+fi
+
+if [[ $do_build -eq 1 ]]; then
+    if [[ ! -f $build/CMakeCache.txt ]]; then
+        cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
+    fi
+    cmake --build "$build" -j2 --target cnc bench_motion components >/dev/null
+fi
+cnc=$build/bin/cnc
+bench_motion=$build/bin/bench_motion
+for tool in "$cnc" "$bench_motion"; do
+    [[ -x $tool ]] || { echo "$0: $tool is missing (build it, or drop --no-build)" >&2; exit 1; }
+done
+
+rel() { realpath --relative-to="$root" "$1"; }
+
+if [[ $check_only -eq 1 ]]; then
+    failed=0
+    for prog in "${programs[@]}"; do
+        if out=$("$cnc" check "$prog" 2>&1); then
+            echo "ok    $(rel "$prog")"
+        else
+            echo "FAIL  $(rel "$prog")"
+            printf '%s\n' "$out" | sed 's/^/      /'
+            failed=1
+        fi
+    done
+    if python3 "$bench_dir"/gen_programs.py --check; then
+        echo "ok    generated programs match bench/gen_programs.py"
+    else
+        failed=1
+    fi
+    exit $failed
+fi
+
+if [[ $use_linuxcnc -eq 1 ]] && ! command -v linuxcnc >/dev/null; then
+    echo "LinuxCNC is not installed: its columns are left empty" >&2
+    use_linuxcnc=0
+fi
+
+# Our planner alone: bench_motion plans each program through the real interpreter and samples
+# it at the servo period (CSV: program,jerk_mm_s3,segments,bound_s,motion_s,ratio,plan_seg_per_s).
+declare -A segments bound ours ratio seg_per_s
+while IFS=, read -r prog jerk segs b m r s; do
+    [[ $prog == program ]] && continue
+    key=$(realpath "$prog")
+    segments[$key]=$segs bound[$key]=$b ours[$key]=$m ratio[$key]=$r seg_per_s[$key]=$s
+done < <("$bench_motion" --jerk 0 --csv "${programs[@]}")
+
+# The whole machine: `cnc run --sim-clock` on bench/sim/bench.ini, timed on the wall clock.
+declare -A run_motion speedup lcnc lcnc_note
+for prog in "${programs[@]}"; do
+    t0=$EPOCHREALTIME
+    summary=$("$cnc" run "$bench_dir"/sim/bench.ini "$prog" --sim-clock 2>&1) || {
+        echo "$0: cnc run failed on $(rel "$prog"):" >&2
+        printf '%s\n' "$summary" | tail -n 5 >&2
+        exit 1
+    }
+    t1=$EPOCHREALTIME
+    motion=$(printf '%s\n' "$summary" | sed -n 's/^motion time: \([0-9.]*\) s$/\1/p')
+    run_motion[$prog]=$motion
+    speedup[$prog]=$(awk -v m="$motion" -v a="$t0" -v b="$t1" 'BEGIN { printf "%.0f", m / (b - a) }')
+done
+
+# LinuxCNC 2.9 in real time (bench/linuxcnc/run.sh): motion time from its servo-cycle count.
+if [[ $use_linuxcnc -eq 1 ]]; then
+    for prog in "${programs[@]}"; do
+        echo "LinuxCNC: $(rel "$prog") ..." >&2
+        if result=$("$bench_dir"/linuxcnc/run.sh "$prog"); then
+            lcnc[$prog]=$(printf '%s\n' "$result" | sed -n 's/^motion_s=//p')
+            runs=$(printf '%s\n' "$result" | sed -n 's/^runs=//p')
+            [[ $runs == 1 ]] || lcnc_note[$prog]=" ($runs runs)"
+        else
+            lcnc[$prog]=failed
+        fi
+    done
+fi
+
+echo "| program | segments | bound s | ours s | ours/bound | cnc run s | LinuxCNC s | ours/LinuxCNC | plan seg/s | sim-clock x real time |"
+echo "|---|---|---|---|---|---|---|---|---|---|"
+for prog in "${programs[@]}"; do
+    key=$(realpath "$prog")
+    l=${lcnc[$prog]:-}
+    vs=""
+    [[ $l =~ ^[0-9.]+$ ]] && vs=$(awk -v a="${ours[$key]}" -v b="$l" 'BEGIN { printf "%.3f", a / b }')
+    printf '| %s | %s | %.3f | %.3f | %.4f | %s | %s | %s | %.3g | %s |\n' \
+        "$(basename "$prog")" "${segments[$key]}" "${bound[$key]}" "${ours[$key]}" \
+        "${ratio[$key]}" "${run_motion[$prog]}" "${l:--}${lcnc_note[$prog]:-}" "${vs:--}" \
+        "${seg_per_s[$key]}" "${speedup[$prog]}"
+done
