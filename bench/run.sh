@@ -5,14 +5,17 @@
 # unlimited), planning throughput, and how much faster than real time `cnc run --sim-clock` ran.
 # See bench/README.md and docs/benchmarks.md ("Motion").
 #
-#   bench/run.sh [--build DIR] [--no-build] [--no-linuxcnc] [--linuxcnc-reps N] [PROGRAM...]
+#   bench/run.sh [--build DIR] [--no-build] [--no-linuxcnc] [--linuxcnc-reps N] [--jerk J]
+#                [PROGRAM...]
 #   bench/run.sh --check      every bench program passes `cnc check`; generated ones up to date
 #
 # --build DIR    build folder (default build-bench/ at the repository root, configured Release
 #                and built here unless --no-build)
 # --no-linuxcnc  skip LinuxCNC (it is skipped anyway when not installed)
 # --linuxcnc-reps N  LinuxCNC runs per program (default 2); the table keeps the shortest
-#                motion time and notes the spread (a loaded machine can only slow LinuxCNC)
+#                motion time and notes the spread
+# --jerk J       also plan with this jerk limit, mm/s^3 (default 100000; 0 = skip): its own
+#                column (LinuxCNC 2.9 has no jerk limit to compare with)
 set -euo pipefail
 
 bench_dir=$(cd "$(dirname "$0")" && pwd)
@@ -21,6 +24,7 @@ build=$root/build-bench
 do_build=1
 use_linuxcnc=1
 linuxcnc_reps=2
+jerk_mm_s3=100000
 check_only=0
 programs=()
 while [[ $# -gt 0 ]]; do
@@ -29,8 +33,9 @@ while [[ $# -gt 0 ]]; do
         --no-build) do_build=0; shift ;;
         --no-linuxcnc) use_linuxcnc=0; shift ;;
         --linuxcnc-reps) linuxcnc_reps=$2; shift 2 ;;
+        --jerk) jerk_mm_s3=$2; shift 2 ;;
         --check) check_only=1; shift ;;
-        -h | --help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        -h | --help) sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         -*) echo "$0: unknown option $1" >&2; exit 64 ;;
         *) programs+=("$(realpath "$1")"); shift ;;
     esac
@@ -81,12 +86,19 @@ fi
 
 # Our planner alone: bench_motion plans each program through the real interpreter and samples
 # it at the servo period (CSV: program,jerk_mm_s3,segments,bound_s,motion_s,ratio,plan_seg_per_s).
-declare -A segments bound ours ratio seg_per_s
+# (--jerk before --csv: a --jerk value list would swallow the program names that follow it.)
+declare -A segments bound ours ratio seg_per_s ours_jerk
+jerks=(--jerk 0)
+[[ $jerk_mm_s3 == 0 ]] || jerks+=(--jerk "$jerk_mm_s3")
 while IFS=, read -r prog jerk segs b m r s; do
     [[ $prog == program ]] && continue
     key=$(realpath "$prog")
+    if [[ $jerk != 0 ]]; then
+        ours_jerk[$key]=$m
+        continue
+    fi
     segments[$key]=$segs bound[$key]=$b ours[$key]=$m ratio[$key]=$r seg_per_s[$key]=$s
-done < <("$bench_motion" --jerk 0 --csv "${programs[@]}")
+done < <("$bench_motion" "${jerks[@]}" --csv "${programs[@]}")
 
 # The whole machine: `cnc run --sim-clock` on bench/sim/bench.ini, timed on the wall clock.
 declare -A run_motion speedup lcnc lcnc_note
@@ -128,15 +140,19 @@ if [[ $use_linuxcnc -eq 1 ]]; then
     done
 fi
 
-echo "| program | segments | bound s | ours s | ours/bound | cnc run s | LinuxCNC s | ours/LinuxCNC | plan seg/s | sim-clock x real time |"
-echo "|---|---|---|---|---|---|---|---|---|---|"
+jerk_head="ours, jerk $jerk_mm_s3 s"
+[[ $jerk_mm_s3 == 0 ]] && jerk_head="ours, jerk-limited s"
+echo "| program | segments | bound s | ours s | ours/bound | cnc run s | LinuxCNC s | ours/LinuxCNC | plan seg/s | sim-clock x real time | $jerk_head |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|"
 for prog in "${programs[@]}"; do
     key=$(realpath "$prog")
     l=${lcnc[$prog]:-}
     vs=""
     [[ $l =~ ^[0-9.]+$ ]] && vs=$(awk -v a="${ours[$key]}" -v b="$l" 'BEGIN { printf "%.3f", a / b }')
-    printf '| %s | %s | %.3f | %.3f | %.4f | %s | %s | %s | %.3g | %s |\n' \
+    j=${ours_jerk[$key]:-}
+    [[ -n $j ]] && j=$(awk -v a="$j" -v b="${ours[$key]}" 'BEGIN { printf "%.3f (%+.3f)", a, a - b }')
+    printf '| %s | %s | %.3f | %.3f | %.4f | %s | %s | %s | %.3g | %s | %s |\n' \
         "$(basename "$prog")" "${segments[$key]}" "${bound[$key]}" "${ours[$key]}" \
         "${ratio[$key]}" "${run_motion[$prog]}" "${l:--}${lcnc_note[$prog]:-}" "${vs:--}" \
-        "${seg_per_s[$key]}" "${speedup[$prog]}"
+        "${seg_per_s[$key]}" "${speedup[$prog]}" "${j:--}"
 done
