@@ -125,16 +125,16 @@ TEST(CutterComp, ManualProgram1IsAPathReversal) {
     const CompError e =
         error_of({line(10, 10, L, 2, 2, true), line(20, 10, L, 2, 3), line(0, 10, Off, 2, 4, true)},
                  Config{}, {0, 0});
-    EXPECT_STREQ(e.what(), "cutter comp: path reversal between line 3 and line 4");
-    EXPECT_EQ(e.first_block, 3);
-    EXPECT_EQ(e.second_block, 4);
+    EXPECT_STREQ(e.what(), "cutter comp: path reversal (with the move at line 3)");
+    EXPECT_EQ(e.earlier_block, 3);
+    EXPECT_EQ(e.at_block, 4);
 }
 
 TEST(CutterComp, ReversalInsideTheContourToo) {
     // S1: "G1 X5 Y10" after "G1 X20 Y10" is an error.
     const CompError e =
         error_of({line(10, 10, L, 2, 2), line(20, 10, L, 2, 3), line(5, 10, L, 2, 4)});
-    EXPECT_STREQ(e.what(), "cutter comp: path reversal between line 3 and line 4");
+    EXPECT_STREQ(e.what(), "cutter comp: path reversal (with the move at line 3)");
 }
 
 TEST(CutterComp, OutsideCornersGetArcsAroundTheCornerPoint) {
@@ -291,8 +291,9 @@ TEST(CutterComp, TooManyMovesWithoutPlaneMotion) {
     moves.push_back(at_h(line(10, 10, L, 1, 6), -3));
     const CompError e = error_of(moves, cfg);
     EXPECT_STREQ(e.what(),
-                 "cutter comp: more than 2 blocks without motion in the compensation plane between "
-                 "line 2 and line 5");
+                 "cutter comp: more than 2 blocks without motion in the compensation plane (with "
+                 "the move at line 2)");
+    EXPECT_EQ(e.at_block, 5);
     // With the perpendicular fallback the path ends on the perpendicular and restarts.
     cfg.on_exhausted = OnLookaheadExhausted::Perpendicular;
     // The restart goes to the perpendicular of line 6 at its start, (9, 0).
@@ -345,29 +346,31 @@ TEST(CutterComp, CompensationOffPassesMovesThrough) {
 
 TEST(CutterCompErrors, StartOnAnArc) {
     const CompError e = error_of({line(10, 0, Off, 0, 1), arc(0, 10, 0, 0, true, L, 1, 2)});
-    EXPECT_STREQ(e.what(),
-                 "cutter comp: compensation cannot start on an arc (line 2, after line 1); start "
-                 "it with G00/G01");
-    EXPECT_EQ(e.first_block, 1);
-    EXPECT_EQ(e.second_block, 2);
+    EXPECT_STREQ(
+        e.what(),
+        "cutter comp: compensation cannot start on an arc; start it with G00/G01 (with the "
+        "move at line 1)");
+    EXPECT_EQ(e.earlier_block, 1);
+    EXPECT_EQ(e.at_block, 2);
 }
 
 TEST(CutterCompErrors, CancelOnAnArc) {
     const CompError e =
         error_of({line(10, 0, L, 1, 1), line(20, 0, L, 1, 2), arc(30, 0, 25, 0, true, Off, 1, 3)});
     EXPECT_STREQ(e.what(),
-                 "cutter comp: compensation cannot be cancelled on an arc (line 3, after line 2); "
-                 "cancel it with G00/G01");
+                 "cutter comp: compensation cannot be cancelled on an arc; cancel it with G00/G01 "
+                 "(with the move at line 2)");
+    EXPECT_EQ(e.at_block, 3);
 }
 
 TEST(CutterCompErrors, ToolLargerThanInsideArc) {
     // CCW arc of radius 3 with G41: the tool (r 4) is on the centre side.
     const CompError e = error_of({line(3, 0, L, 4, 1), arc(0, 3, 0, 0, true, L, 4, 2)});
     EXPECT_STREQ(e.what(),
-                 "cutter comp: the tool radius 4 does not fit the inside arc of radius 3 at line 2 "
-                 "(compensation from line 1)");
-    EXPECT_EQ(e.first_block, 1);
-    EXPECT_EQ(e.second_block, 2);
+                 "cutter comp: the tool radius 4 does not fit the inside arc of radius 3 (with the "
+                 "move at line 1)");
+    EXPECT_EQ(e.earlier_block, 1);
+    EXPECT_EQ(e.at_block, 2);
 }
 
 TEST(CutterCompErrors, GougeWhenTheToolDoesNotFitAnInsideCorner) {
@@ -377,8 +380,9 @@ TEST(CutterCompErrors, GougeWhenTheToolDoesNotFitAnInsideCorner) {
                                   line(0, 10, L, 6, 4), line(0, 0, L, 6, 5)});
     EXPECT_STREQ(
         e.what(),
-        "cutter comp: gouge: the tool radius 6 does not fit the inside corner between line "
-        "3 and line 4");
+        "cutter comp: gouge: the tool radius 6 does not fit the inside corner (with the move at "
+        "line 3)");
+    EXPECT_EQ(e.at_block, 4);
 }
 
 TEST(CutterCompErrors, GougeIntoAnEarlierMove) {
@@ -388,10 +392,11 @@ TEST(CutterCompErrors, GougeIntoAnEarlierMove) {
         error_of({line(0, 0, L, 1, 1), line(10, 0, L, 1, 2), line(10, 10, L, 1, 3),
                   line(0, 10, L, 1, 4), line(0, 0, L, 1, 5), line(5, 5, Off, 1, 6)});
     EXPECT_STREQ(e.what(),
-                 "cutter comp: gouge: the tool path of line 5 comes within 0 of the contour of "
-                 "line 2 (tool radius 1)");
-    EXPECT_EQ(e.first_block, 2);
-    EXPECT_EQ(e.second_block, 5);
+                 "cutter comp: gouge: the tool (radius 1) would come within 0 of the contour of "
+                 "line 2 (with the move at line 5)");
+    EXPECT_EQ(e.contour_block, 2);
+    EXPECT_EQ(e.earlier_block, 5);
+    EXPECT_EQ(e.at_block, 6);  // the cancel fixes where line 5 ends
     // Non-adjacent moves: line 6 runs back 2 above line 2 with r = 1.5 on the
     // side facing it. Every corner is fine locally (the corners between are
     // 10–20 long), but the corner before line 6 and line 6 itself pass 0.5 from line 2.
@@ -401,8 +406,9 @@ TEST(CutterCompErrors, GougeIntoAnEarlierMove) {
                   line(-5, 2, Off, 1.5, 7)},
                  Config{}, {0, -5});
     EXPECT_STREQ(far.what(),
-                 "cutter comp: gouge: the tool path of line 6 comes within 0.5 of the contour of "
-                 "line 2 (tool radius 1.5)");
+                 "cutter comp: gouge: the tool (radius 1.5) would come within 0.5 of the contour "
+                 "of line 2 (with the move at line 5)");
+    EXPECT_EQ(far.at_block, 6);  // the corner into line 6 passes 0.5 from line 2
     Config off;
     off.gouge_check_moves = 0;
     EXPECT_STREQ(error_of({line(0, 0, L, 1.5, 1), line(20, 0, L, 1.5, 2), line(20, 20, L, 1.5, 3),
@@ -418,8 +424,8 @@ TEST(CutterCompErrors, PlaneChangeWhileActive) {
     m.plane = 18;
     const CompError e = error_of({line(0, 0, L, 1, 1), line(10, 0, L, 1, 2), m});
     EXPECT_STREQ(e.what(),
-                 "cutter comp: the plane changed from G17 to G18 while compensation is active (set "
-                 "at line 1, changed at line 3)");
+                 "cutter comp: the plane changed from G17 to G18 while compensation is active "
+                 "(with the move at line 2)");
 }
 
 TEST(CutterCompErrors, PositionCannotBeSetWhileActive) {

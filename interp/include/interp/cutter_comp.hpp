@@ -44,7 +44,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
-#include <deque>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -60,12 +60,26 @@ using SourceTag = std::int64_t;
 
 enum class Side { Off, Left, Right };  // G40, G41, G42
 
+/// A compensation error. The compensator finds most errors only when a later block shows the
+/// corner (look-ahead), so two blocks are involved: `at_block`, the block being pushed when the
+/// error was found (where it is reported), and `earlier_block`, the held block whose compensated
+/// path cannot be made. A gouge also names the contour move the tool would cut (`contour_block`).
 class CompError : public std::runtime_error {
   public:
-    CompError(const std::string& what, SourceTag first, SourceTag second)
-        : std::runtime_error(what), first_block(first), second_block(second) {}
-    SourceTag first_block;
-    SourceTag second_block;
+    using Namer = std::function<std::string(SourceTag)>;
+
+    CompError(std::string reason, SourceTag earlier, SourceTag at,
+              std::optional<SourceTag> contour = std::nullopt, std::string tail = {});
+
+    /// "<reason>[ <contour block><tail>] (with the move at <earlier block>)", blocks named by
+    /// `name`; the suffix is left out when both blocks are the same.
+    std::string message(const Namer& name) const;
+
+    std::string reason;
+    SourceTag earlier_block;
+    SourceTag at_block;
+    std::optional<SourceTag> contour_block;
+    std::string tail;
 };
 
 enum class Shape { Line, Arc };
@@ -150,6 +164,10 @@ class Compensator {
     ~Compensator();
     Compensator(Compensator&&) noexcept;
     Compensator& operator=(Compensator&&) noexcept;
+    /// Copies are how a caller makes a block atomic: push into a copy, keep it only when no
+    /// CompError was thrown. Assigning to an existing compensator reuses its storage.
+    Compensator(const Compensator& other);
+    Compensator& operator=(const Compensator& other);
 
     /// Tells the compensator where the tool is (after G92, G28, a program start).
     /// Only while compensation is off and nothing is held.
@@ -167,6 +185,8 @@ class Compensator {
 
     /// True while a compensated move is held (compensation on).
     bool active() const { return pending_ != nullptr; }
+    /// The held compensated move, while active.
+    std::optional<SourceTag> held_move() const;
 
   private:
     struct Pending;  // the held contour move, defined in compensator.cpp
@@ -191,8 +211,9 @@ class Compensator {
     Vec2 tool_;  // end of the last emitted output
     double tool_h_;
     std::optional<SourceTag> last_tag_;
+    SourceTag current_tag_ = 0;  // the entry being pushed: where an error is reported
     std::unique_ptr<Pending> pending_;
-    std::deque<Held> held_;
+    std::vector<Held> held_;
     std::size_t held_moves_ = 0;
     std::vector<Output> out_;
 };

@@ -255,13 +255,17 @@ void Executor::end_of_input(const SourceLoc& loc) {
 void Executor::commit(ExecState&& st, std::optional<ProgramTransform>&& xf,
                       std::optional<Settings>&& settings, std::vector<Canon>& out) {
     const AxisVec machine_before = state_.pos.machine_mm;
+    // Cutter compensation finds its errors by look-ahead: staging it first lets a block it
+    // rejects commit nothing (CrcStage::stage changes nothing when it throws).
+    const bool through_crc = crc_.engaged() || st.crc.side != cutter::Side::Off;
+    if (through_crc) crc_.stage(out, st.crc, machine_before);
     state_ = st;
     if (xf) xf_ = std::move(*xf);
     const bool settings_changed = settings && !(*settings == settings_);
     if (settings) settings_ = std::move(*settings);
     if (settings_changed && settings_listener_) settings_listener_(settings_);
-    if (crc_.engaged() || state_.crc.side != cutter::Side::Off)
-        crc_.pass(out, state_.crc, machine_before);  // may throw a look-ahead error
+    if (through_crc)
+        crc_.emit_staged();
     else
         for (const Canon& c : out) sink_.emit(c);
 }

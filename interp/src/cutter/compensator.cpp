@@ -83,7 +83,7 @@ struct Compensator::Pending {
     double u_start = 0;              // Contour: where the offset starts after the previous corner
     Move move;                       // the block itself (side, radius, plane, tag, rapid)
     SourceTag on_tag{};              // the block that switched compensation (or its side) on
-    std::deque<Recent> recent;       // the last contour moves, for the gouge check
+    std::vector<Recent> recent;      // the last contour moves, for the gouge check
     std::optional<Recent> upcoming;  // the move being joined, while its corner is emitted
 
     void become_contour(const Segment& s, const Curve& c, double u, const Move& m, SourceTag on,
@@ -96,7 +96,7 @@ struct Compensator::Pending {
         on_tag = on;
         upcoming.reset();
         recent.push_back(Recent{s, m.tag, bounds(s)});
-        while (recent.size() > window) recent.pop_front();
+        if (recent.size() > window) recent.erase(recent.begin(), recent.end() - window);
     }
 };
 
@@ -106,12 +106,82 @@ Compensator::~Compensator() = default;
 Compensator::Compensator(Compensator&&) noexcept = default;
 Compensator& Compensator::operator=(Compensator&&) noexcept = default;
 
+Compensator::Compensator(const Compensator& other)
+    : config_(other.config_),
+      programmed_(other.programmed_),
+      programmed_h_(other.programmed_h_),
+      tool_(other.tool_),
+      tool_h_(other.tool_h_),
+      last_tag_(other.last_tag_),
+      current_tag_(other.current_tag_),
+      pending_(other.pending_ ? std::make_unique<Pending>(*other.pending_) : nullptr),
+      held_(other.held_),
+      held_moves_(other.held_moves_),
+      out_(other.out_) {}
+
+Compensator& Compensator::operator=(const Compensator& other) {
+    if (this == &other) return *this;
+    config_ = other.config_;
+    programmed_ = other.programmed_;
+    programmed_h_ = other.programmed_h_;
+    tool_ = other.tool_;
+    tool_h_ = other.tool_h_;
+    last_tag_ = other.last_tag_;
+    current_tag_ = other.current_tag_;
+    // Assigning into the existing Pending keeps its vector's capacity: no allocation per block.
+    if (!other.pending_)
+        pending_.reset();
+    else if (pending_)
+        *pending_ = *other.pending_;
+    else
+        pending_ = std::make_unique<Pending>(*other.pending_);
+    held_ = other.held_;
+    held_moves_ = other.held_moves_;
+    out_ = other.out_;
+    return *this;
+}
+
+std::optional<SourceTag> Compensator::held_move() const {
+    if (!pending_) return std::nullopt;
+    return pending_->move.tag;
+}
+
+namespace {
+
+std::string compose(const std::string& reason, SourceTag earlier, SourceTag at,
+                    const std::optional<SourceTag>& contour, const std::string& tail,
+                    const CompError::Namer& name) {
+    std::string text = reason;
+    if (contour) text += fmt::format(" {}{}", name(*contour), tail);
+    if (earlier != at) text += fmt::format(" (with the move at {})", name(earlier));
+    return text;
+}
+
+// what() names blocks by their tags, for callers whose tags are line numbers.
+std::string tag_as_line(SourceTag t) {
+    return fmt::format("line {}", t);
+}
+
+}  // namespace
+
+CompError::CompError(std::string reason_text, SourceTag earlier, SourceTag at,
+                     std::optional<SourceTag> contour, std::string tail_text)
+    : std::runtime_error(compose(reason_text, earlier, at, contour, tail_text, tag_as_line)),
+      reason(std::move(reason_text)),
+      earlier_block(earlier),
+      at_block(at),
+      contour_block(contour),
+      tail(std::move(tail_text)) {}
+
+std::string CompError::message(const Namer& name) const {
+    return compose(reason, earlier_block, at_block, contour_block, tail, name);
+}
+
 void Compensator::set_position(const Vec2& position, double h) {
-    if (pending_ || !held_.empty()) {
-        const SourceTag t = last_tag_.value_or(0);
+    if (pending_ || !held_.empty())
         throw CompError(
-            "cutter comp: the position cannot be redefined while compensation is active", t, t);
-    }
+            "cutter comp: the position cannot be redefined while compensation is active",
+            pending_ ? pending_->move.tag : last_tag_.value_or(0), last_tag_.value_or(0));
     programmed_ = tool_ = position;
     programmed_h_ = tool_h_ = h;
 }
@@ -123,6 +193,7 @@ std::vector<Output> Compensator::drain() {
 }
 
 void Compensator::push(const Marker& marker) {
+    current_tag_ = marker.tag;
     if (pending_)
         held_.emplace_back(marker);
     else
@@ -132,6 +203,7 @@ void Compensator::push(const Marker& marker) {
 void Compensator::push(const Move& programmed) {
     // CRC-7: a negative radius swaps G41 and G42.
     Move move = programmed;
+    current_tag_ = move.tag;
     if (move.radius_mm < 0) {
         move.radius_mm = -move.radius_mm;
         if (move.side != Side::Off) move.side = move.side == Side::Left ? Side::Right : Side::Left;
@@ -139,9 +211,9 @@ void Compensator::push(const Move& programmed) {
     const Segment seg = Segment::make(programmed_, programmed_h_, move);
     if (pending_ && move.plane != pending_->move.plane)
         throw CompError(fmt::format("cutter comp: the plane changed from G{} to G{} while "
-                                    "compensation is active (set at line {}, changed at line {})",
-                                    pending_->move.plane, move.plane, pending_->on_tag, move.tag),
-                        pending_->on_tag, move.tag);
+                                    "compensation is active",
+                                    pending_->move.plane, move.plane),
+                        pending_->move.tag, move.tag);
     if (seg.degenerate()) {
         push_no_plane_motion(move);
     } else if (!pending_) {
@@ -215,21 +287,22 @@ void Compensator::push_no_plane_motion(const Move& move) {
     if (++held_moves_ <= config_.lookahead_moves) return;
     if (config_.on_exhausted == OnLookaheadExhausted::Error)
         throw CompError(fmt::format("cutter comp: more than {} blocks without motion in the "
-                                    "compensation plane between line {} and line {}",
-                                    config_.lookahead_moves, pending_->move.tag, move.tag),
+                                    "compensation plane",
+                                    config_.lookahead_moves),
                         pending_->move.tag, move.tag);
     end_pending_perpendicular();
 }
 
 namespace {
 
-Curve offset_or_throw(const Segment& seg, const Move& move, SourceTag on_tag) {
+/// `before` is the block ahead of `move` (the held move, or the start-up block).
+Curve offset_or_throw(const Segment& seg, const Move& move, SourceTag before) {
     const auto curve = geom::offset(seg, side_sign(move.side) * move.radius_mm);
     if (!curve)
         throw CompError(fmt::format("cutter comp: the tool radius {:g} does not fit the inside arc "
-                                    "of radius {:g} at line {} (compensation from line {})",
-                                    move.radius_mm, seg.radius, move.tag, on_tag),
-                        on_tag, move.tag);
+                                    "of radius {:g}",
+                                    move.radius_mm, seg.radius),
+                        before, move.tag);
     return *curve;
 }
 
@@ -256,8 +329,7 @@ std::optional<std::pair<double, double>> inside_joint(const Curve& a, double a_u
 
 void check_reversal(const Vec2& t_in, const Vec2& t_out, SourceTag a, SourceTag b) {
     if (std::abs(geom::cross(t_in, t_out)) <= kParallel && t_in.dot(t_out) < 0)
-        throw CompError(fmt::format("cutter comp: path reversal between line {} and line {}", a, b),
-                        a, b);
+        throw CompError("cutter comp: path reversal", a, b);
 }
 
 }  // namespace
@@ -265,9 +337,7 @@ void check_reversal(const Vec2& t_in, const Vec2& t_out, SourceTag a, SourceTag 
 void Compensator::start_up(const Move& move) {
     if (move.shape == Shape::Arc) {
         const SourceTag before = last_tag_.value_or(move.tag);
-        throw CompError(fmt::format("cutter comp: compensation cannot start on an arc (line {}, "
-                                    "after line {}); start it with G00/G01",
-                                    move.tag, before),
+        throw CompError("cutter comp: compensation cannot start on an arc; start it with G00/G01",
                         before, move.tag);
     }
     pending_ = std::make_unique<Pending>();
@@ -279,7 +349,7 @@ void Compensator::start_up(const Move& move) {
 
 void Compensator::finish_start_up(const Move& move) {
     const Segment seg = Segment::make(programmed_, programmed_h_, move);
-    const Curve curve = offset_or_throw(seg, move, pending_->on_tag);
+    const Curve curve = offset_or_throw(seg, move, pending_->move.tag);
     // S0 §3.5.3: the start-up block ends on the perpendicular at the next block's start.
     emit_line(curve.at(0), pending_->seg.h1, pending_->move.rapid, Role::Startup,
               pending_->move.tag);
@@ -290,7 +360,7 @@ void Compensator::finish_start_up(const Move& move) {
 void Compensator::link(const Move& move) {
     const Segment seg = Segment::make(programmed_, programmed_h_, move);
     const SourceTag on_tag = move.side != pending_->move.side ? move.tag : pending_->on_tag;
-    const Curve curve = offset_or_throw(seg, move, on_tag);
+    const Curve curve = offset_or_throw(seg, move, pending_->move.tag);
     emit_line(curve.at(0), seg.h0, move.rapid, Role::Startup, move.tag);
     pending_->become_contour(seg, curve, 0.0, move, on_tag, config_.gouge_check_moves);
 }
@@ -298,7 +368,7 @@ void Compensator::link(const Move& move) {
 void Compensator::join(const Move& move) {
     Pending& a = *pending_;
     const Segment seg = Segment::make(programmed_, programmed_h_, move);
-    const Curve next = offset_or_throw(seg, move, a.on_tag);
+    const Curve next = offset_or_throw(seg, move, a.move.tag);
     a.upcoming = Pending::Recent{seg, move.tag, bounds(seg)};
     const Vec2 t_in = a.seg.tangent(1.0);
     const Vec2 t_out = seg.tangent(0.0);
@@ -315,11 +385,10 @@ void Compensator::join(const Move& move) {
         // corner, which must lie within what is left of each move.
         const auto best = inside_joint(a.curve, a.u_start, next, seg.start);
         if (!best)
-            throw CompError(
-                fmt::format("cutter comp: gouge: the tool radius {:g} does not fit the inside "
-                            "corner between line {} and line {}",
-                            r, a.move.tag, move.tag),
-                a.move.tag, move.tag);
+            throw CompError(fmt::format("cutter comp: gouge: the tool radius {:g} does not fit "
+                                        "the inside corner",
+                                        r),
+                            a.move.tag, move.tag);
         emit_piece(a.curve.piece(a.u_start, best->first), a.move.rapid, Role::Contour, a.move.tag);
         u_next = best->second;
     } else {
@@ -351,10 +420,9 @@ void Compensator::join(const Move& move) {
 
 void Compensator::cancel(const Move& move) {
     if (move.shape == Shape::Arc)
-        throw CompError(fmt::format("cutter comp: compensation cannot be cancelled on an arc "
-                                    "(line {}, after line {}); cancel it with G00/G01",
-                                    move.tag, pending_->move.tag),
-                        pending_->move.tag, move.tag);
+        throw CompError(
+            "cutter comp: compensation cannot be cancelled on an arc; cancel it with G00/G01",
+            pending_->move.tag, move.tag);
     if (pending_->kind == Pending::Kind::Contour) {
         Pending& a = *pending_;
         const Segment seg = Segment::make(programmed_, programmed_h_, move);
@@ -449,10 +517,10 @@ void Compensator::check_gouge(const OutMove& piece, double radius_mm) const {
             nearest =
                 std::min(nearest, r.seg.distance(sample(piece, static_cast<double>(i) / samples)));
         if (nearest < radius_mm - kToleranceMm)
-            throw CompError(fmt::format("cutter comp: gouge: the tool path of line {} comes within "
-                                        "{:.4g} of the contour of line {} (tool radius {:g})",
-                                        piece.tag, nearest, r.tag, radius_mm),
-                            r.tag, piece.tag);
+            throw CompError(fmt::format("cutter comp: gouge: the tool (radius {:g}) would come "
+                                        "within {:.4g} of the contour of",
+                                        radius_mm, nearest),
+                            pending_->move.tag, current_tag_, r.tag);
     };
     for (const auto& r : pending_->recent) check(r);
     if (pending_->upcoming) check(*pending_->upcoming);
