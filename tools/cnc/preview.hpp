@@ -1,9 +1,17 @@
-// `cnc run --preview FILE.svg`: a picture of the path the machine followed, in three views at
-// one scale (XY from above, XZ from the front, YZ from the side), rapids and feed moves in
-// different colours.
+// `cnc run --preview FILE.png|FILE.svg`: a picture of the path the machine followed, for a
+// machinist to read at a glance. Four panels in third-angle layout — top (XY) above front (XZ),
+// right side (YZ) beside the front, an isometric view top right — each scaled to fill its own
+// panel at equal aspect ratio, with axis arrows, extents and a scale bar in mm. Feed moves are
+// solid blue, rapids dashed red; the start is a green dot, the end a black square. A title line
+// names the program and gives the path length and motion time. See docs/preview.md.
+//
+// Memory and output stay bounded whatever the program's length: samples are thinned as they
+// arrive (never moving the drawn path by more than error_bound_mm()), and each view is thinned
+// again in pixels before drawing.
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -17,21 +25,78 @@ enum class MoveKind : std::uint8_t { Other, Rapid, Feed };
 // counts as feed. Throws interp::Error (`file:line:col: reason`) for a bad program.
 std::vector<MoveKind> classify_lines(const std::string& program, const std::string& dialect);
 
+// Empty when `path` ends in .png or .svg (any case); otherwise why --preview cannot write it,
+// naming the file.
+std::string preview_path_error(const std::string& path);
+
+// Picture geometry, pixels (SVG user units), y down. Exposed so tests can find the panels.
+inline constexpr int kPictureWidthPx = 1200;
+inline constexpr int kPictureHeightPx = 980;
+enum class View : std::uint8_t { Top, Front, Side, Iso };
+struct PixelBox {
+    double x, y, w, h;
+};
+PixelBox panel_box(View view);  // a panel's frame, including its caption and footer
+PixelBox plot_box(View view);   // the part of a panel the path is scaled into
+
+struct PreviewLimits {
+    // Stored vertices, all runs together. Past this the stored path is thinned with a coarser
+    // tolerance until at most half this remains (so thinning costs O(1) amortized per sample).
+    std::size_t max_points = 400'000;
+    // Vertices written to an SVG, all four views together (about 16 bytes each): past this
+    // each view is thinned more coarsely. Bounds the SVG's size; a PNG's is bounded by its
+    // pixels.
+    std::size_t max_svg_vertices = 300'000;
+};
+
+struct PreviewCaption {
+    std::string program;  // shown as given
+    std::string machine;  // the config; may be empty
+    double motion_time_s = 0;
+};
+
 class Preview {
   public:
-    explicit Preview(std::vector<MoveKind> line_kinds) : line_kinds_(std::move(line_kinds)) {}
-    // One sample of the commanded position (mm) and the program line it belongs to.
+    explicit Preview(std::vector<MoveKind> line_kinds, PreviewLimits limits = {});
+    // One sample of the commanded position (mm) and the program line it belongs to. A line
+    // that is neither rapid nor feed (or unknown) continues the current kind.
     void add(const std::array<double, 3>& xyz_mm, int line);
-    // Writes the SVG; throws std::runtime_error when the file cannot be written.
-    void write_svg(const std::string& path, const std::string& title) const;
+    // Writes a PNG or an SVG, chosen by the file's extension. Throws std::runtime_error naming
+    // the file for another extension or when it cannot be written.
+    void write(const std::string& path, const PreviewCaption& caption) const;
 
-  private:
+    std::size_t samples() const { return samples_; }
+    std::size_t stored_points() const { return stored_; }
+    // No sample is farther than this from the stored path: 1 µm until the point budget is
+    // reached, then the sum of the coarser tolerances used.
+    double error_bound_mm() const { return error_bound_mm_; }
+    double feed_length_mm() const { return length_mm_[1]; }
+    double rapid_length_mm() const { return length_mm_[0]; }
+
+    using Point = std::array<double, 3>;
     struct Run {
         MoveKind kind;
-        std::vector<std::array<double, 3>> points;
+        std::vector<Point> points;  // joined: a run starts where the one before ended
     };
+    const std::vector<Run>& runs() const { return runs_; }
+
+  private:
+    void compact();
+    MoveKind kind_of(int line) const;
+
     std::vector<MoveKind> line_kinds_;
+    PreviewLimits limits_;
     std::vector<Run> runs_;
+    // Samples since the last stored vertex of the open run, all within tolerance_mm_ of the
+    // chord from that vertex to the newest sample (the open run's last point).
+    std::vector<Point> pending_;
+    double tolerance_mm_;
+    double error_bound_mm_;
+    std::size_t samples_ = 0;
+    std::size_t stored_ = 0;
+    std::array<double, 2> length_mm_{0, 0};  // rapid, feed
+    Point lo_{}, hi_{};                      // extents of every sample
+    Point start_{}, end_{};
 };
 
 }  // namespace cncrun
