@@ -61,7 +61,7 @@ struct Words {
         w.p_ms = v;
         return *this;
     }
-    Words& k(long v) {
+    Words& k(double v) {
         w.k = v;
         return *this;
     }

@@ -124,7 +124,8 @@ TEST(CannedCycle, G76OrientsShiftsInTheOssDirectionAndShiftsBack) {
     s.ctx.return_to_r = true;
     EXPECT_EQ(s.run(CycleCode::G76, Words().x(5).y(5).z(-10).r(-5).q(2).p(5000)),
               (Lines{"rapid X5 Y5 Z10", "rapid X5 Y5 Z-5", "feed X5 Y5 Z-10 F800", "dwell 5s",
-                     "spindle orient", "rapid X7 Y5 Z-10", "rapid X7 Y5 Z-5", "rapid X5 Y5 Z-5",
+                     "spindle orient tip=(-1 0 0)", "rapid X7 Y5 Z-10", "rapid X7 Y5 Z-5",
+                     "rapid X5 Y5 Z-5",
                      "spindle restart"}));
 }
 
@@ -174,9 +175,9 @@ TEST(CannedCycle, G87BackBoresUpFromRWithShiftsAroundTheTool) {
     // 8) shift +Q, restart.
     Session s;
     EXPECT_EQ(s.run(CycleCode::G87, Words().x(5).y(5).z(-5).r(-15).q(5).p(4000)),
-              (Lines{"rapid X5 Y5 Z10", "spindle orient", "rapid X0 Y5 Z10", "rapid X0 Y5 Z-15",
-                     "rapid X5 Y5 Z-15", "spindle cw", "feed X5 Y5 Z-5 F800", "dwell 4s",
-                     "spindle orient", "rapid X0 Y5 Z-5", "rapid X0 Y5 Z10", "rapid X5 Y5 Z10",
+              (Lines{"rapid X5 Y5 Z10", "spindle orient tip=(1 0 0)", "rapid X0 Y5 Z10",
+                     "rapid X0 Y5 Z-15", "rapid X5 Y5 Z-15", "spindle cw", "feed X5 Y5 Z-5 F800",
+                     "dwell 4s", "spindle orient tip=(1 0 0)", "rapid X0 Y5 Z-5", "rapid X0 Y5 Z10", "rapid X5 Y5 Z10",
                      "spindle restart"}));
 }
 
@@ -189,15 +190,22 @@ TEST(CannedCycle, G87TreatsG99AsG98WithAWarning) {
     EXPECT_EQ(to_string(e.steps[e.steps.size() - 3]), "rapid X0 Y5 Z10");
 }
 
-TEST(CannedCycle, G87NeedsRBelowZ) {
-    // The manual's own G87 example (Z-10 R-5) puts R above Z: rejected.
+TEST(CannedCycle, G87WithRAboveZRunsAsWrittenWithAWarning) {
+    // FEATURES A-10: the manual's own G87 example (Z-10 R-5) puts R above Z. It is a flow test:
+    // the steps run as programmed (the "feed up to Z" goes down from R -5 to Z -10) and warn.
     Session s;
-    try {
-        s.run(CycleCode::G87, Words().x(5).y(5).z(-10).r(-5).q(5));
-        FAIL();
-    } catch (const CycleError& e) {
-        EXPECT_NE(std::string(e.what()).find("must lie below Z"), std::string::npos);
-    }
+    s.ctx.return_to_r = false;
+    const Expansion e =
+        s.state.run_block(CycleCode::G87, Words().x(5).y(5).z(-10).r(-5).q(5), s.ctx, s.cfg);
+    ASSERT_EQ(e.warnings.size(), 1u);
+    EXPECT_EQ(e.warnings[0],
+              "G87 back boring: the R plane (-5) lies above Z (-10); R is meant to be the hole "
+              "bottom, the steps run as programmed");
+    EXPECT_EQ(texts(e),
+              (Lines{"rapid X5 Y5 Z10", "spindle orient tip=(1 0 0)", "rapid X0 Y5 Z10",
+                     "rapid X0 Y5 Z-5", "rapid X5 Y5 Z-5", "spindle cw", "feed X5 Y5 Z-10 F800",
+                     "spindle orient tip=(1 0 0)", "rapid X0 Y5 Z-10", "rapid X0 Y5 Z10",
+                     "rapid X5 Y5 Z10", "spindle restart"}));
 }
 
 TEST(CannedCycle, G88FeedRetractAndManualRetract) {
@@ -394,7 +402,7 @@ TEST(CycleErrors, EachMessage) {
     {
         Session s;
         EXPECT_EQ(error_of(s, CycleCode::G81, Words().x(5).z(-10).r(-5).k(-1)),
-                  "the repeat count K must be 0 or more, got -1");
+                  "the repeat count K must be a whole number in 0…99999999, got -1");
     }
     {
         Session s;

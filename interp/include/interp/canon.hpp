@@ -89,8 +89,13 @@ struct SetSpindleSpeed {
 struct Spindle {  // M03 / M04 / M05
     SpindleDir dir = SpindleDir::Stop;
 };
-struct SpindleOrient {};  // oriented spindle stop (inside G76/G87)
-struct Coolant {          // M08 / M09
+// Oriented spindle stop (inside G76/G87): the spindle stops with the cutter tip pointing at
+// tip_angle_deg in the machine XY plane (counter-clockwise from +X), opposite to the shift
+// that follows, so the tool clears the bore wall (FEATURES G76-2, #FIXEDCYCLE_OSS).
+struct SpindleOrient {
+    double tip_angle_deg = 0;
+};
+struct Coolant {  // M08 / M09
     bool flood = false;
 };
 struct SpindleClamp {  // M10 / M11 (V5.4)

@@ -101,6 +101,8 @@ class Executor final : public BlockExecutor, public MachineQuery {
   private:
     void commit(ExecState&& st, std::optional<ProgramTransform>&& xf,
                 std::optional<Settings>&& settings, std::vector<Canon>& out);
+    // The block's commands to the sink, through cutter compensation while it is engaged.
+    void pass(std::vector<Canon>& out, const AxisVec& machine_before);
 
     CanonSink& sink_;
     BackendConfig cfg_;

@@ -34,12 +34,21 @@ std::vector<Vec2> g37_grid(Vec2 start_mm, double pitch_x_mm, long count_x, doubl
 /// The words of a G34–G37 block (P is the G36 angle step or the G37 X count).
 struct PatternWords {
     std::optional<double> x_mm, y_mm, i, j, p;
-    std::optional<long> k;
+    std::optional<double> k;  // as written; must be a whole number
+};
+
+/// A pattern's holes by index, computed on demand (a G37 grid may hold 9999×9999 holes).
+struct HolePattern {
+    long count = 0;
+    HoleAt at;  // hole i (0 ≤ i < count) in X/Y
 };
 
 /// Dispatches a G34…G37 block: checks that a canned cycle is active (the
 /// manual's error text otherwise), resolves X/Y under G90/G91 (incremental from
-/// current_xy) and returns the hole positions.
+/// current_xy) and validates the words; the holes are produced on demand.
+HolePattern hole_pattern_lazy(int g_number, const PatternWords& words, bool incremental,
+                              Vec2 current_xy_mm, bool cycle_active);
+/// hole_pattern_lazy with every position listed.
 std::vector<Vec2> hole_pattern(int g_number, const PatternWords& words, bool incremental,
                                Vec2 current_xy_mm, bool cycle_active);
 

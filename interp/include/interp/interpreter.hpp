@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "interp/block.hpp"
+#include "interp/cycles.hpp"
 #include "interp/dialect.hpp"
 #include "interp/flow.hpp"
 #include "interp/parser.hpp"
@@ -76,8 +77,9 @@ class Interpreter {
     bool custom_code_active(int code) const;
     void collect_custom_codes(Block& b, bool has_call);
     void queue_s_hook(const Block& b);
-    void take_fixed_cycle_args(Block& b);
-    void set_fixed_cycle_vars(const SourceLoc& loc);
+    std::optional<cycles::CustomCycles::Run> plan_custom_cycle(Block& b,
+                                                               cycles::CustomCycles& next);
+    void set_fixed_cycle_vars(const cycles::CustomCycles::Run& run, const SourceLoc& loc);
     void handle_return(const ReturnRequest& r, const SourcePos& after_call);
     void return_in_main(const ReturnRequest& r, const SourcePos& after_call);
     void return_to_sequence(const ReturnRequest& r, const SourcePos& after_call);
@@ -98,7 +100,7 @@ class Interpreter {
     std::unique_ptr<Source> library_;
     std::vector<CallFrame> stack_;
     std::vector<CustomCall> customs_;                  // custom codes of the current block
-    std::array<std::optional<double>, 51> fc_args_{};  // #FC arguments of a custom G code
+    cycles::CustomCycles custom_cycles_;  // public.dat canned cycles and their modal data
     Source* current_ = nullptr;
     bool finished_ = true;
     bool main_started_ =

@@ -235,9 +235,13 @@ cycles::CycleWords BlockRun::cycle_words() const {
     if (b_.has('P')) w.p_ms = b_.get('P');
     // C-14: NcStudio documents K and uses L in its examples; both are the repeat count.
     if (b_.has('K'))
-        w.k = std::lround(b_.get('K'));
+        w.k = b_.get('K');
     else if (b_.has('L'))
-        w.k = std::lround(b_.get('L'));
+        w.k = b_.get('L');
+    if (cfg_.v54_compat) {  // V5.4 G76 X Y Z R U V P F L (G76-4)
+        if (b_.has('U')) w.u_mm = mm('U');
+        if (b_.has('V')) w.v_mm = mm('V');
+    }
     return w;
 }
 
@@ -255,6 +259,8 @@ cycles::CycleConfig BlockRun::cycle_config() const {
     };
     if (auto back = setting("FIXEDCYCLE_BACK")) c.retract_mm = *back;
     if (auto oss = setting("FIXEDCYCLE_OSS")) c.oss_direction = static_cast<int>(*oss);
+    c.g76_shift_uv = cfg_.v54_compat;
+    if (auto cycp = setting("CYCP")) c.g76_shift_feed_mm_min = *cycp;
     return c;
 }
 
@@ -264,9 +270,7 @@ void BlockRun::run_cycle() {
     if (cycle_code_ && *cycle_code_ != gcode(80))
         code = cycles::cycle_code_from_g(*cycle_code_ / 10);
     try {
-        const cycles::Expansion e =
-            st.cycle.run_block(code, cycle_words(), cycle_context(), cycle_config());
-        emit_cycle_steps(e);
+        begin_holes(st.cycle.start_block(code, cycle_words(), cycle_context(), cycle_config()));
     } catch (const cycles::CycleError& e) {
         fail(cycle_code_ ? loc_g(*cycle_code_) : b_.loc, e.what());
     }
@@ -281,27 +285,58 @@ void BlockRun::run_hole_pattern() {
     if (b_.has('I')) w.i = mm('I');
     if (b_.has('J')) w.j = code == gcode(37) ? mm('J') : b_.get('J');
     if (b_.has('P')) w.p = b_.get('P');
-    if (b_.has('K')) w.k = std::lround(b_.get('K'));
+    if (b_.has('K')) w.k = b_.get('K');
     try {
-        const auto holes =
-            cycles::hole_pattern(code / 10, w, st.motion.incremental,
-                                 {st.pos.prog_mm[0], st.pos.prog_mm[1]}, st.cycle.active());
-        emit_cycle_steps(st.cycle.drill_at(holes, cycle_context(), cycle_config()));
+        cycles::HolePattern holes =
+            cycles::hole_pattern_lazy(code / 10, w, st.motion.incremental,
+                                      {st.pos.prog_mm[0], st.pos.prog_mm[1]}, st.cycle.active());
+        begin_holes(st.cycle.drill_pattern(holes.count, std::move(holes.at), cycle_context(),
+                                           cycle_config()));
     } catch (const cycles::CycleError& e) {
         fail(loc_g(code), e.what());
     }
 }
 
-void BlockRun::emit_cycle_steps(const cycles::Expansion& e) {
-    for (const std::string& w : e.warnings) emit(canon::Warning{w});
-    const SpindleDir dir_at_start = st.spindle.dir;
+// The block's first hole is converted now, inside the block (its errors were all thrown by the
+// cycles core already); the executor asks for the others after the commit (next_pending_hole),
+// so a K1000000 block never holds more than one hole. A block that also stops or ends the
+// program keeps every hole before that stop.
+void BlockRun::begin_holes(cycles::BlockHoles&& b) {
+    for (const std::string& w : b.warnings) emit(canon::Warning{w});
+    holes_ = std::move(b.holes);
+    cycle_dir_at_start_ = st.spindle.dir;
+    next_pending_hole();
+    if (m(0) || m(1) || m(2) || m(30))
+        while (next_pending_hole()) {
+        }
+}
+
+bool BlockRun::next_pending_hole() {
+    if (!holes_.next(hole_steps_)) return false;
+    emit_cycle_steps(hole_steps_);
+    return true;
+}
+
+// The cutter-tip direction of an oriented stop as a machine XY angle: rotation and mirroring
+// turn the direction the OSS table gives in program coordinates.
+double BlockRun::orient_angle_deg(const cycles::Vec3& tip_dir) const {
+    const Eigen::Vector3d m =
+        xf().matrix().linear() * Eigen::Vector3d(tip_dir[0], tip_dir[1], tip_dir[2]);
+    double deg = std::atan2(m.y(), m.x()) * 180.0 / std::numbers::pi;
+    if (deg < 0) deg += 360.0;
+    deg = std::round(deg * 1e9) / 1e9;  // 179.99999999997 after a G68 R90 pair prints as 180
+    return deg >= 360.0 ? 0.0 : deg + 0.0;
+}
+
+void BlockRun::emit_cycle_steps(const std::vector<cycles::Step>& steps) {
+    const SpindleDir dir_at_start = cycle_dir_at_start_;
     const double modal_feed = st.feed.feed_mm_s;
     double announced_feed = modal_feed;
     auto set_dir = [&](SpindleDir d) {
         st.spindle.dir = d;
         emit(canon::Spindle{d});
     };
-    for (const cycles::Step& step : e.steps) {
+    for (const cycles::Step& step : steps) {
         std::visit(
             [&](const auto& s) {
                 using T = std::decay_t<decltype(s)>;
@@ -329,7 +364,7 @@ void BlockRun::emit_cycle_steps(const cycles::Expansion& e) {
                     set_dir(SpindleDir::Stop);
                 } else if constexpr (std::is_same_v<T, cycles::SpindleOrient>) {
                     st.spindle.dir = SpindleDir::Stop;
-                    emit(canon::SpindleOrient{});
+                    emit(canon::SpindleOrient{orient_angle_deg(s.tip_dir)});
                 } else if constexpr (std::is_same_v<T, cycles::SpindleReverse>) {
                     set_dir(st.spindle.dir == SpindleDir::Cw ? SpindleDir::Ccw : SpindleDir::Cw);
                 } else if constexpr (std::is_same_v<T, cycles::SpindleRestart>) {

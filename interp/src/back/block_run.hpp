@@ -65,6 +65,9 @@ class BlockRun {
         : st(st), b_(b), cfg_(cfg), base_xf_(xf), base_settings_(settings), out_(out) {}
 
     void run();
+    bool has_pending_holes() const { return holes_.holes_done() < holes_.hole_count(); }
+    /// Appends the next hole of the block's canned cycle to the output; false when none is left.
+    bool next_pending_hole();
 
     ExecState st;
     std::optional<ProgramTransform> xf_copy;
@@ -181,7 +184,9 @@ class BlockRun {
     cycles::CycleConfig cycle_config() const;
     void run_cycle();
     void run_hole_pattern();
-    void emit_cycle_steps(const cycles::Expansion& e);
+    void begin_holes(cycles::BlockHoles&& b);
+    void emit_cycle_steps(const std::vector<cycles::Step>& steps);
+    double orient_angle_deg(const cycles::Vec3& tip_dir) const;
 
     const Block& b_;
     const BackendConfig& cfg_;
@@ -193,6 +198,9 @@ class BlockRun {
     std::optional<int> cycle_code_;   // G73..G89 or G80 written in this block
     const GInfo* axis_user_ = nullptr;
     unsigned groups_ = 0;
+    cycles::HoleRun holes_;                     // this block's canned-cycle holes, made lazily
+    std::vector<cycles::Step> hole_steps_;      // one hole's steps
+    SpindleDir cycle_dir_at_start_ = SpindleDir::Stop;
 };
 
 }  // namespace interp::back

@@ -87,7 +87,9 @@ struct TextVisitor {
                 return "spindle stop";
         }
     }
-    std::string operator()(const canon::SpindleOrient&) const { return "spindle-orient"; }
+    std::string operator()(const canon::SpindleOrient& c) const {
+        return fmt::format("spindle-orient tip={}deg", fmt_num(c.tip_angle_deg));
+    }
     std::string operator()(const canon::Coolant& c) const {
         return c.flood ? "coolant on" : "coolant off";
     }

@@ -241,7 +241,22 @@ void Executor::execute(const Block& block) {
     out_.clear();
     BlockRun run(block, cfg_, state_, xf_, settings_, out_);
     run.run();  // throws: nothing below runs, nothing was changed
-    commit(std::move(run.st), std::move(run.xf_copy), std::move(run.settings_copy), out_);
+    if (!run.has_pending_holes()) {
+        commit(std::move(run.st), std::move(run.xf_copy), std::move(run.settings_copy), out_);
+        return;
+    }
+    // A canned-cycle block with more holes (K repeats, G34–G37) was validated with its first
+    // hole; the others are made and passed on one at a time, so memory stays flat (issue 4).
+    commit(ExecState(run.st), std::optional<ProgramTransform>(run.xf_copy),
+           std::optional<Settings>(run.settings_copy), out_);
+    while (true) {
+        const AxisVec before = state_.pos.machine_mm;
+        out_.clear();
+        if (!run.next_pending_hole()) break;
+        state_.pos = run.st.pos;
+        state_.spindle = run.st.spindle;
+        pass(out_, before);
+    }
 }
 
 void Executor::end_of_input(const SourceLoc& loc) {
@@ -255,17 +270,17 @@ void Executor::end_of_input(const SourceLoc& loc) {
 void Executor::commit(ExecState&& st, std::optional<ProgramTransform>&& xf,
                       std::optional<Settings>&& settings, std::vector<Canon>& out) {
     const AxisVec machine_before = state_.pos.machine_mm;
-    // Cutter compensation finds its errors by look-ahead: staging it first lets a block it
-    // rejects commit nothing (CrcStage::stage changes nothing when it throws).
-    const bool through_crc = crc_.engaged() || st.crc.side != cutter::Side::Off;
-    if (through_crc) crc_.stage(out, st.crc, machine_before);
     state_ = st;
     if (xf) xf_ = std::move(*xf);
     const bool settings_changed = settings && !(*settings == settings_);
     if (settings) settings_ = std::move(*settings);
     if (settings_changed && settings_listener_) settings_listener_(settings_);
-    if (through_crc)
-        crc_.emit_staged();
+    pass(out, machine_before);
+}
+
+void Executor::pass(std::vector<Canon>& out, const AxisVec& machine_before) {
+    if (crc_.engaged() || state_.crc.side != cutter::Side::Off)
+        crc_.pass(out, state_.crc, machine_before);  // may throw a look-ahead error
     else
         for (const Canon& c : out) sink_.emit(c);
 }

@@ -32,8 +32,8 @@ bool has_hole_word(const CycleWords& w) {
 }
 
 /// Resolves the stored data into one hole's parameters (position filled later).
-HoleSpec make_spec(const CycleData& d, const BlockContext& ctx, const CycleConfig& cfg,
-                   Expansion& out) {
+/// The data every hole needs, also for a library cycle O(600+n) (its #FC3 and #FC5).
+void check_data(const CycleData& d) {
     const CycleCode code = *d.code;
     const int g = g_number(code);
     if (!d.z_level_mm)
@@ -45,6 +45,13 @@ HoleSpec make_spec(const CycleData& d, const BlockContext& ctx, const CycleConfi
         throw CycleError(fmt::format("G{}: the peck depth Q is missing", g));
     if (needs_peck_depth(code) && *d.q_mm == 0.0)
         throw CycleError(fmt::format("G{}: the peck depth Q must not be 0", g));
+}
+
+HoleSpec make_spec(const CycleData& d, const BlockContext& ctx, const CycleConfig& cfg,
+                   Expansion& out) {
+    const CycleCode code = *d.code;
+    const int g = g_number(code);
+    check_data(d);
     if (cfg.retract_mm < 0.0)
         throw CycleError(
             fmt::format("#FIXEDCYCLE_BACK must not be negative, it is {:g}", cfg.retract_mm));
@@ -62,7 +69,24 @@ HoleSpec make_spec(const CycleData& d, const BlockContext& ctx, const CycleConfi
     spec.feed_mm_min = ctx.feed_mm_min;
     spec.spindle_rpm = ctx.spindle_rpm;
     spec.shift_dir = {0.0, 0.0};
-    if (code == CycleCode::G76 || code == CycleCode::G87) spec.shift_dir = detail::oss_shift(cfg);
+    spec.shift_uv_mm.reset();
+    if (code == CycleCode::G76 && cfg.g76_shift_uv) {
+        spec.shift_uv_mm = d.shift_uv_mm;
+        spec.shift_feed_mm_min =
+            cfg.g76_shift_feed_mm_min > 0 ? cfg.g76_shift_feed_mm_min : ctx.feed_mm_min;
+        const double len = std::hypot(d.shift_uv_mm[0], d.shift_uv_mm[1]);
+        if (len > 0) spec.shift_dir = {d.shift_uv_mm[0] / len, d.shift_uv_mm[1] / len};
+        else spec.shift_dir = detail::oss_shift(cfg);
+    } else if (code == CycleCode::G76 || code == CycleCode::G87) {
+        spec.shift_dir = detail::oss_shift(cfg);
+    }
+    // FEATURES A-10/EX-13: S0's own G87 example (Z-10 R-5) puts R above Z. Back boring needs R
+    // (the hole bottom) below Z, but the example is a flow test, so the steps run as written.
+    if (code == CycleCode::G87 && spec.r_mm > spec.z_mm)
+        out.warnings.push_back(fmt::format(
+            "G87 back boring: the R plane ({:g}) lies above Z ({:g}); R is meant to be the hole "
+            "bottom, the steps run as programmed",
+            spec.r_mm, spec.z_mm));
     if (code == CycleCode::G87 && ctx.return_to_r)
         out.warnings.push_back(
             "G87 returns to the initial level: the hole bottom is R, so G99 is treated as G98");
@@ -104,44 +128,59 @@ CycleState::Plan CycleState::accept(std::optional<CycleCode> code, const CycleWo
         data_.z_level_mm = ctx.incremental ? r_base + *z : *z;
     }
     if (words.q_mm) data_.q_mm = std::abs(*words.q_mm);
+    if (words.u_mm) data_.shift_uv_mm[0] = *words.u_mm;
+    if (words.v_mm) data_.shift_uv_mm[1] = *words.v_mm;
     if (words.p_ms) {
         if (*words.p_ms < 0.0)
             throw CycleError(fmt::format("dwell P must not be negative, got {:g}", *words.p_ms));
         data_.dwell_ms = *words.p_ms;
     }
-    const long repeat = words.k.value_or(1);
-    if (repeat < 0)
-        throw CycleError(fmt::format("the repeat count K must be 0 or more, got {}", repeat));
+    const double k = words.k.value_or(1.0);
+    if (k != std::floor(k) || k < 0 || k > static_cast<double>(kMaxRepeat))
+        throw CycleError(fmt::format("the repeat count K must be a whole number in 0…{}, got {:g}",
+                                     kMaxRepeat, k));
+    const auto repeat = static_cast<long>(k);
     return Plan{has_hole_word(words) && repeat > 0, repeat};
+}
+
+BlockHoles CycleState::start_block(std::optional<CycleCode> code, const CycleWords& words,
+                                  const BlockContext& ctx, const CycleConfig& cfg) {
+    CycleState next = *this;
+    const Plan plan = next.accept(code, words, ctx, cfg);
+    BlockHoles out;
+    if (plan.drills) {
+        Expansion warnings;
+        const HoleSpec spec = make_spec(next.data_, ctx, cfg, warnings);
+        out.warnings = std::move(warnings.warnings);
+        const AxisMap ax = spec.axes;
+        const std::array<double, 2> from{ctx.position_mm[ax.a], ctx.position_mm[ax.b]};
+        HoleAt at;
+        if (ctx.incremental) {
+            // G91: every repeat steps by the increment (equally spaced holes, CC-10).
+            const std::array<double, 2> step{words.axis_mm[ax.a].value_or(0.0),
+                                             words.axis_mm[ax.b].value_or(0.0)};
+            at = [from, step](long i) -> std::array<double, 2> {
+                const auto n = static_cast<double>(i + 1);
+                return {from[0] + n * step[0], from[1] + n * step[1]};
+            };
+        } else {
+            // G90: the same hole again.
+            const std::array<double, 2> hole{words.axis_mm[ax.a].value_or(from[0]),
+                                             words.axis_mm[ax.b].value_or(from[1])};
+            at = [hole](long) { return hole; };
+        }
+        out.holes = HoleRun(spec, ctx, cfg, plan.repeat, std::move(at));
+    }
+    *this = next;
+    return out;
 }
 
 Expansion CycleState::run_block(std::optional<CycleCode> code, const CycleWords& words,
                                 const BlockContext& ctx, const CycleConfig& cfg) {
-    CycleState next = *this;
-    const Plan plan = next.accept(code, words, ctx, cfg);
+    BlockHoles b = start_block(code, words, ctx, cfg);
     Expansion out;
-    if (plan.drills) {
-        HoleSpec spec = make_spec(next.data_, ctx, cfg, out);
-        const AxisMap ax = spec.axes;
-        Vec3 position = ctx.position_mm;
-        double a = ctx.position_mm[ax.a];
-        double b = ctx.position_mm[ax.b];
-        for (long i = 0; i < plan.repeat; ++i) {
-            // G91: every repeat steps by the increment (equally spaced holes);
-            // G90: the same hole again (CC-10).
-            if (ctx.incremental) {
-                a += words.axis_mm[ax.a].value_or(0.0);
-                b += words.axis_mm[ax.b].value_or(0.0);
-            } else {
-                a = words.axis_mm[ax.a].value_or(ctx.position_mm[ax.a]);
-                b = words.axis_mm[ax.b].value_or(ctx.position_mm[ax.b]);
-            }
-            spec.pos_a_mm = a;
-            spec.pos_b_mm = b;
-            detail::append_hole(spec, ctx, cfg, position, out);
-        }
-    }
-    *this = next;
+    out.warnings = std::move(b.warnings);
+    b.holes.drain_into(out);
     return out;
 }
 
@@ -151,6 +190,7 @@ std::optional<FcVariables> CycleState::run_custom_block(std::optional<CycleCode>
                                                         const CycleConfig& cfg) {
     CycleState next = *this;
     const Plan plan = next.accept(code, words, ctx, cfg);
+    if (plan.drills) check_data(next.data_);
     *this = next;
     if (!plan.drills) return std::nullopt;
 
@@ -178,22 +218,52 @@ std::optional<FcVariables> CycleState::run_custom_block(std::optional<CycleCode>
     return fc;
 }
 
-Expansion CycleState::drill_at(const std::vector<std::array<double, 2>>& holes,
-                               const BlockContext& ctx, const CycleConfig& cfg) const {
+BlockHoles CycleState::drill_pattern(long count, HoleAt hole_xy, const BlockContext& ctx,
+                                     const CycleConfig& cfg) const {
     if (!data_.code)
         throw CycleError(
             "G34/35/36/37 instruction error: special canned cycle mismatch, none specified");
     if (ctx.drill_axis_scaled)
         throw CycleError("a canned cycle cannot run while the drilling axis is scaled (G51)");
-    Expansion out;
-    HoleSpec spec = make_spec(data_, ctx, cfg, out);
-    Vec3 position = ctx.position_mm;
-    for (const auto& hole : holes) {
-        spec.pos_a_mm = hole[0];
-        spec.pos_b_mm = hole[1];
-        detail::append_hole(spec, ctx, cfg, position, out);
-    }
+    Expansion warnings;
+    const HoleSpec spec = make_spec(data_, ctx, cfg, warnings);
+    BlockHoles out;
+    out.warnings = std::move(warnings.warnings);
+    out.holes = HoleRun(spec, ctx, cfg, count, std::move(hole_xy));
     return out;
+}
+
+Expansion CycleState::drill_at(const std::vector<std::array<double, 2>>& holes,
+                               const BlockContext& ctx, const CycleConfig& cfg) const {
+    BlockHoles b = drill_pattern(static_cast<long>(holes.size()),
+                                 [&holes](long i) { return holes[static_cast<std::size_t>(i)]; },
+                                 ctx, cfg);
+    Expansion out;
+    out.warnings = std::move(b.warnings);
+    b.holes.drain_into(out);
+    return out;
+}
+
+HoleRun::HoleRun(const HoleSpec& spec, const BlockContext& ctx, const CycleConfig& cfg,
+                 long count, HoleAt at)
+    : spec_(spec), ctx_(ctx), cfg_(cfg), count_(count), at_(std::move(at)),
+      position_(ctx.position_mm) {
+    if (count_ > 0) detail::check_hole(spec_, ctx_, cfg_);
+}
+
+bool HoleRun::next(std::vector<Step>& steps) {
+    steps.clear();
+    if (next_ >= count_) return false;
+    const std::array<double, 2> ab = at_(next_++);
+    spec_.pos_a_mm = ab[0];
+    spec_.pos_b_mm = ab[1];
+    detail::append_hole(spec_, ctx_, cfg_, position_, steps);
+    return true;
+}
+
+void HoleRun::drain_into(Expansion& out) {
+    std::vector<Step> hole;
+    while (next(hole)) out.steps.insert(out.steps.end(), hole.begin(), hole.end());
 }
 
 }  // namespace interp::cycles

@@ -31,13 +31,39 @@ void check_positive_count(int g, char letter, long count) {
             fmt::format("G{}: the hole count {}={} must be between 1 and 9999", g, letter, count));
 }
 
-std::vector<Vec2> arc_holes(Vec2 centre, double radius, double first_deg, double step_deg,
-                            long count) {
+HolePattern arc_pattern(Vec2 centre, double radius, double first_deg, double step_deg,
+                        long count) {
     // K > 0 runs clockwise: the angle decreases.
-    const double direction = count > 0 ? -1.0 : 1.0;
+    const double signed_step = (count > 0 ? -1.0 : 1.0) * step_deg;
+    return {std::labs(count), [=](long i) {
+                return polar(centre, radius, first_deg + signed_step * static_cast<double>(i));
+            }};
+}
+
+HolePattern line_pattern(Vec2 start, double spacing, double angle_deg, long count) {
+    check_positive_count(35, 'K', count);
+    return {count,
+            [=](long i) { return polar(start, spacing * static_cast<double>(i), angle_deg); }};
+}
+
+HolePattern grid_pattern(Vec2 start, double pitch_x, long count_x, double pitch_y,
+                         long count_y) {
+    check_positive_count(37, 'P', count_x);
+    check_positive_count(37, 'K', count_y);
+    // Serpentine rows (REC SC-9): even rows run +X, odd rows come back.
+    return {count_x * count_y, [=](long i) -> Vec2 {
+                const long row = i / count_x;
+                const long n = i % count_x;
+                const long col = row % 2 == 0 ? n : count_x - 1 - n;
+                return {start[0] + pitch_x * static_cast<double>(col),
+                        start[1] + pitch_y * static_cast<double>(row)};
+            }};
+}
+
+std::vector<Vec2> list(const HolePattern& p) {
     std::vector<Vec2> holes;
-    for (long i = 0; i < std::labs(count); ++i)
-        holes.push_back(polar(centre, radius, first_deg + direction * step_deg * i));
+    holes.reserve(static_cast<std::size_t>(p.count));
+    for (long i = 0; i < p.count; ++i) holes.push_back(p.at(i));
     return holes;
 }
 
@@ -50,6 +76,9 @@ T require(const std::optional<T>& word, int g, char letter) {
 long whole_count(double value, int g, char letter) {
     if (value != std::floor(value))
         throw CycleError(fmt::format("G{}: {} must be a whole number, got {:g}", g, letter, value));
+    // Far beyond every count range below; keeps the conversion to long defined.
+    if (std::abs(value) > 1e9)
+        throw CycleError(fmt::format("G{}: the hole count {}={:g} is out of range", g, letter, value));
     return static_cast<long>(value);
 }
 
@@ -57,38 +86,26 @@ long whole_count(double value, int g, char letter) {
 
 std::vector<Vec2> g34_bolt_circle(Vec2 centre, double radius, double first_deg, long count) {
     check_signed_count(34, count);
-    return arc_holes(centre, radius, first_deg, 360.0 / static_cast<double>(std::labs(count)),
-                     count);
+    return list(arc_pattern(centre, radius, first_deg,
+                            360.0 / static_cast<double>(std::labs(count)), count));
 }
 
 std::vector<Vec2> g35_line(Vec2 start, double spacing, double angle_deg, long count) {
-    check_positive_count(35, 'K', count);
-    std::vector<Vec2> holes;
-    for (long i = 0; i < count; ++i) holes.push_back(polar(start, spacing * i, angle_deg));
-    return holes;
+    return list(line_pattern(start, spacing, angle_deg, count));
 }
 
 std::vector<Vec2> g36_arc(Vec2 centre, double radius, double first_deg, double step_deg,
                           long count) {
     check_signed_count(36, count);
-    return arc_holes(centre, radius, first_deg, step_deg, count);
+    return list(arc_pattern(centre, radius, first_deg, step_deg, count));
 }
 
 std::vector<Vec2> g37_grid(Vec2 start, double pitch_x, long count_x, double pitch_y, long count_y) {
-    check_positive_count(37, 'P', count_x);
-    check_positive_count(37, 'K', count_y);
-    std::vector<Vec2> holes;
-    for (long row = 0; row < count_y; ++row) {
-        for (long n = 0; n < count_x; ++n) {
-            const long col = row % 2 == 0 ? n : count_x - 1 - n;
-            holes.push_back({start[0] + pitch_x * col, start[1] + pitch_y * row});
-        }
-    }
-    return holes;
+    return list(grid_pattern(start, pitch_x, count_x, pitch_y, count_y));
 }
 
-std::vector<Vec2> hole_pattern(int g, const PatternWords& w, bool incremental, Vec2 current,
-                               bool cycle_active) {
+HolePattern hole_pattern_lazy(int g, const PatternWords& w, bool incremental, Vec2 current,
+                              bool cycle_active) {
     if (!cycle_active)
         throw CycleError(
             "G34/35/36/37 instruction error: special canned cycle mismatch, none specified");
@@ -96,19 +113,32 @@ std::vector<Vec2> hole_pattern(int g, const PatternWords& w, bool incremental, V
         incremental ? Vec2{current[0] + w.x_mm.value_or(0.0), current[1] + w.y_mm.value_or(0.0)}
                     : Vec2{w.x_mm.value_or(current[0]), w.y_mm.value_or(current[1])};
     switch (g) {
-        case 34:
-            return g34_bolt_circle(origin, require(w.i, g, 'I'), w.j.value_or(0.0),
-                                   require(w.k, g, 'K'));
+        case 34: {
+            const long k = whole_count(require(w.k, g, 'K'), g, 'K');
+            check_signed_count(34, k);
+            return arc_pattern(origin, require(w.i, g, 'I'), w.j.value_or(0.0),
+                               360.0 / static_cast<double>(std::labs(k)), k);
+        }
         case 35:
-            return g35_line(origin, require(w.i, g, 'I'), w.j.value_or(0.0), require(w.k, g, 'K'));
-        case 36:
-            return g36_arc(origin, require(w.i, g, 'I'), w.j.value_or(0.0), require(w.p, g, 'P'),
-                           require(w.k, g, 'K'));
+            return line_pattern(origin, require(w.i, g, 'I'), w.j.value_or(0.0),
+                                whole_count(require(w.k, g, 'K'), g, 'K'));
+        case 36: {
+            const long k = whole_count(require(w.k, g, 'K'), g, 'K');
+            check_signed_count(36, k);
+            return arc_pattern(origin, require(w.i, g, 'I'), w.j.value_or(0.0),
+                               require(w.p, g, 'P'), k);
+        }
         case 37:
-            return g37_grid(origin, require(w.i, g, 'I'), whole_count(require(w.p, g, 'P'), g, 'P'),
-                            require(w.j, g, 'J'), require(w.k, g, 'K'));
+            return grid_pattern(origin, require(w.i, g, 'I'),
+                                whole_count(require(w.p, g, 'P'), g, 'P'), require(w.j, g, 'J'),
+                                whole_count(require(w.k, g, 'K'), g, 'K'));
     }
     throw CycleError(fmt::format("G{} is not a hole-pattern cycle (G34…G37)", g));
+}
+
+std::vector<Vec2> hole_pattern(int g, const PatternWords& w, bool incremental, Vec2 current,
+                               bool cycle_active) {
+    return list(hole_pattern_lazy(g, w, incremental, current, cycle_active));
 }
 
 }  // namespace interp::cycles

@@ -19,7 +19,7 @@ constexpr long kMaxPecks = 100000;
 /// a G99 retract that is already at R), and tracks the tool position.
 class Emitter {
   public:
-    Emitter(const HoleSpec& hole, Vec3& position, Expansion& out)
+    Emitter(const HoleSpec& hole, Vec3& position, std::vector<Step>& out)
         : hole_(hole), pos_(position), out_(out) {}
 
     void rapid_to_level(double c_mm) { move_level(c_mm, true); }
@@ -38,14 +38,33 @@ class Emitter {
         to[hole_.axes.b] = b_mm;
         move(to, true);
     }
+    void feed_in_plane(double a_mm, double b_mm, double feed_mm_min) {
+        Vec3 to = pos_;
+        to[hole_.axes.a] = a_mm;
+        to[hole_.axes.b] = b_mm;
+        bool same = true;
+        for (int i = 0; i < 3; ++i) same = same && std::abs(to[i] - pos_[i]) <= kSameLevelMm;
+        if (same) return;
+        out_.emplace_back(Feed{to, feed_mm_min, false});
+        pos_ = to;
+    }
     void rapid_shift(double sign) {
         rapid_in_plane(hole_.pos_a_mm + sign * hole_.q_mm * hole_.shift_dir[0],
                        hole_.pos_b_mm + sign * hole_.q_mm * hole_.shift_dir[1]);
     }
     void dwell() {
-        if (hole_.dwell_s > 0.0) out_.steps.emplace_back(Dwell{hole_.dwell_s});
+        if (hole_.dwell_s > 0.0) out_.emplace_back(Dwell{hole_.dwell_s});
     }
-    void push(Step step) { out_.steps.push_back(step); }
+    void push(Step step) { out_.push_back(step); }
+    /// Oriented stop before a shift of shift_sign·Q: the tip points the other way, so the
+    /// shift takes it off the bore wall (G76 shifts +Q, G87 −Q: its tip faces the OSS side).
+    void orient(double shift_sign) {
+        Vec3 tip{};
+        // + 0.0 turns −0 into 0 for the printed form.
+        tip[hole_.axes.a] = -shift_sign * hole_.shift_dir[0] + 0.0;
+        tip[hole_.axes.b] = -shift_sign * hole_.shift_dir[1] + 0.0;
+        push(SpindleOrient{tip});
+    }
     double level() const { return pos_[hole_.axes.c]; }
 
   private:
@@ -59,15 +78,15 @@ class Emitter {
         for (int i = 0; i < 3; ++i) same = same && std::abs(to[i] - pos_[i]) <= kSameLevelMm;
         if (same) return;
         if (rapid)
-            out_.steps.emplace_back(Rapid{to});
+            out_.emplace_back(Rapid{to});
         else
-            out_.steps.emplace_back(Feed{to, hole_.feed_mm_min, lock_override_});
+            out_.emplace_back(Feed{to, hole_.feed_mm_min, lock_override_});
         pos_ = to;
     }
 
     const HoleSpec& hole_;
     Vec3& pos_;
-    Expansion& out_;
+    std::vector<Step>& out_;
     bool lock_override_ = false;
 };
 
@@ -110,7 +129,6 @@ void g82(const HoleSpec& h, const CycleConfig&, const BlockContext&, Emitter& e)
 // 6) rapid to initial/R. No δ retract after the last peck (it is the retract).
 void g73(const HoleSpec& h, const CycleConfig& cfg, const BlockContext&, Emitter& e) {
     approach(h, e);
-    peck_count(h);
     double depth = h.r_mm;
     while (depth > h.z_mm) {
         depth = std::max(depth - h.q_mm, h.z_mm);
@@ -125,7 +143,6 @@ void g73(const HoleSpec& h, const CycleConfig& cfg, const BlockContext&, Emitter
 // 6) feed Q deeper 7) rapid to R 8) repeat to Z 9) rapid to initial/R.
 void g83(const HoleSpec& h, const CycleConfig& cfg, const BlockContext&, Emitter& e) {
     approach(h, e);
-    peck_count(h);
     double depth = h.r_mm;
     while (depth > h.z_mm) {
         if (depth < h.r_mm) e.rapid_to_level(std::min(depth + cfg.retract_mm, h.r_mm));
@@ -139,12 +156,7 @@ void g83(const HoleSpec& h, const CycleConfig& cfg, const BlockContext&, Emitter
 // G74/G84: 3) G01 to Z 4) dwell P, reverse 5) G01 up to R 6) dwell P, reverse
 // back 7) G00 to the initial level (G98). The tapping speed parameter replaces S
 // for the cut (NcStudio G84 note) and S is restored once back at R.
-void tap(const HoleSpec& h, const CycleConfig& cfg, const BlockContext& ctx, Emitter& e,
-         Spindle required, const char* m_code) {
-    if (ctx.spindle != required)
-        throw CycleError(
-            fmt::format("G{} needs the spindle running {} ({}) before the cycle", g_number(h.code),
-                        required == Spindle::Cw ? "clockwise" : "counter-clockwise", m_code));
+void tap(const HoleSpec& h, const CycleConfig& cfg, Emitter& e) {
     approach(h, e);
     if (cfg.tap_spindle_rpm) e.push(SpindleSpeed{*cfg.tap_spindle_rpm});
     e.tap_to_level(h.z_mm);
@@ -156,22 +168,39 @@ void tap(const HoleSpec& h, const CycleConfig& cfg, const BlockContext& ctx, Emi
     if (cfg.tap_spindle_rpm) e.push(SpindleSpeed{h.spindle_rpm});
     e.rapid_to_level(return_level(h));
 }
-void g74(const HoleSpec& h, const CycleConfig& cfg, const BlockContext& ctx, Emitter& e) {
-    tap(h, cfg, ctx, e, Spindle::Ccw, "M04");
+void g74(const HoleSpec& h, const CycleConfig& cfg, const BlockContext&, Emitter& e) {
+    tap(h, cfg, e);
 }
-void g84(const HoleSpec& h, const CycleConfig& cfg, const BlockContext& ctx, Emitter& e) {
-    tap(h, cfg, ctx, e, Spindle::Cw, "M03");
+void g84(const HoleSpec& h, const CycleConfig& cfg, const BlockContext&, Emitter& e) {
+    tap(h, cfg, e);
+}
+
+// Tapping needs the spindle already turning the cycle's way (G74 M04, G84 M03).
+void check_tap_spindle(const HoleSpec& h, const BlockContext& ctx) {
+    const bool left = h.code == CycleCode::G74;
+    if (!left && h.code != CycleCode::G84) return;
+    const Spindle required = left ? Spindle::Ccw : Spindle::Cw;
+    if (ctx.spindle != required)
+        throw CycleError(fmt::format("G{} needs the spindle running {} ({}) before the cycle",
+                                     g_number(h.code), left ? "counter-clockwise" : "clockwise",
+                                     left ? "M04" : "M03"));
 }
 
 // G76: 2) G00 to R without orienting 3) G01 to Z, dwell P, oriented stop
 // 4) shift Q in the OSS direction 5) G00 to initial/R 6) restart the spindle.
 // REC G76-1: shift back before the restart so the next hole starts centred.
+// V5.4 (G76-4): the shift is U in X and V in Y, fed at the CYCP speed; the tip points against
+// it. Shifting back at the return level follows REC G76-1 as in the 6th edition.
 void g76(const HoleSpec& h, const CycleConfig&, const BlockContext&, Emitter& e) {
     approach(h, e);
     e.feed_to_level(h.z_mm);
     e.dwell();
-    e.push(SpindleOrient{});
-    e.rapid_shift(+1.0);
+    e.orient(+1.0);
+    if (h.shift_uv_mm)
+        e.feed_in_plane(h.pos_a_mm + (*h.shift_uv_mm)[0], h.pos_b_mm + (*h.shift_uv_mm)[1],
+                        h.shift_feed_mm_min);
+    else
+        e.rapid_shift(+1.0);
     e.rapid_to_level(return_level(h));
     e.rapid_shift(0.0);
     e.push(SpindleRestart{});
@@ -199,14 +228,14 @@ void g86(const HoleSpec& h, const CycleConfig&, const BlockContext&, Emitter& e)
 // stop, shift −Q 7) G00 up to the initial level 8) shift +Q, restart.
 void g87(const HoleSpec& h, const CycleConfig&, const BlockContext&, Emitter& e) {
     e.rapid_in_plane(h.pos_a_mm, h.pos_b_mm);
-    e.push(SpindleOrient{});
+    e.orient(-1.0);
     e.rapid_shift(-1.0);
     e.rapid_to_level(h.r_mm);
     e.rapid_shift(0.0);
     e.push(SpindleCw{});
     e.feed_to_level(h.z_mm);
     e.dwell();
-    e.push(SpindleOrient{});
+    e.orient(-1.0);
     e.rapid_shift(-1.0);
     e.rapid_to_level(h.initial_mm);
     e.rapid_shift(0.0);
@@ -250,11 +279,7 @@ constexpr CycleEntry kCycles[] = {
 
 void check_levels(const HoleSpec& h) {
     if (h.code == CycleCode::G87) {
-        if (h.r_mm > h.z_mm)
-            throw CycleError(fmt::format(
-                "G87 back boring: the R plane ({:g}) is the hole bottom and must lie below Z "
-                "({:g})",
-                h.r_mm, h.z_mm));
+        // R above Z (the manual's own example) only warns: see make_spec.
         if (h.initial_mm < h.z_mm)
             throw CycleError(fmt::format(
                 "G87 back boring: the initial level ({:g}) must lie above Z ({:g}), the tool "
@@ -311,9 +336,14 @@ std::array<double, 2> oss_shift(const CycleConfig& cfg) {
         fmt::format("oriented spindle stop direction #FIXEDCYCLE_OSS={} is not in the table", d));
 }
 
-void append_hole(const HoleSpec& hole, const BlockContext& ctx, const CycleConfig& cfg,
-                 Vec3& position, Expansion& out) {
+void check_hole(const HoleSpec& hole, const BlockContext& ctx, const CycleConfig&) {
     check_levels(hole);
+    if (hole.code == CycleCode::G73 || hole.code == CycleCode::G83) peck_count(hole);
+    check_tap_spindle(hole, ctx);
+}
+
+void append_hole(const HoleSpec& hole, const BlockContext& ctx, const CycleConfig& cfg,
+                 Vec3& position, std::vector<Step>& out) {
     for (const auto& entry : kCycles) {
         if (entry.code != hole.code) continue;
         Emitter emitter(hole, position, out);

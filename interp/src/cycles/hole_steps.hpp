@@ -6,35 +6,16 @@
 
 namespace interp::cycles::detail {
 
-/// Indices into Vec3 of the two positioning axes (a, b) and the drilling axis c.
-struct AxisMap {
-    int a;
-    int b;
-    int c;
-};
 AxisMap axis_map(Plane plane, bool drill_axis_follows_plane);
 
-/// Everything one hole needs, resolved to absolute levels on the drilling axis.
-struct HoleSpec {
-    CycleCode code;
-    AxisMap axes;
-    double pos_a_mm;
-    double pos_b_mm;
-    double r_mm;
-    double z_mm;
-    double initial_mm;
-    bool return_to_r;
-    double q_mm;
-    double dwell_s;
-    double feed_mm_min;
-    double spindle_rpm;
-    std::array<double, 2> shift_dir;  // unit vector in (a, b) for G76/G87
-};
+/// Throws CycleError when the block's levels, peck depth or spindle direction make every hole
+/// impossible; called once, before any hole is generated.
+void check_hole(const HoleSpec& hole, const BlockContext& ctx, const CycleConfig& cfg);
 
-/// Appends the steps of one hole to out, starting from position (updated to the
-/// tool position after the hole). Throws CycleError for impossible geometry.
+/// Appends the steps of one hole to steps, starting from position (updated to the tool position
+/// after the hole). check_hole must have accepted the spec.
 void append_hole(const HoleSpec& hole, const BlockContext& ctx, const CycleConfig& cfg,
-                 Vec3& position, Expansion& out);
+                 Vec3& position, std::vector<Step>& steps);
 
 /// Unit shift vector in (a, b) for the oriented-stop direction parameter.
 std::array<double, 2> oss_shift(const CycleConfig& cfg);

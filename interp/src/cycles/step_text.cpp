@@ -19,7 +19,10 @@ struct StepText {
     }
     std::string operator()(const Dwell& s) const { return fmt::format("dwell {:g}s", s.seconds); }
     std::string operator()(const SpindleStop&) const { return "spindle stop"; }
-    std::string operator()(const SpindleOrient&) const { return "spindle orient"; }
+    std::string operator()(const SpindleOrient& s) const {
+        return fmt::format("spindle orient tip=({:g} {:g} {:g})", s.tip_dir[0], s.tip_dir[1],
+                           s.tip_dir[2]);
+    }
     std::string operator()(const SpindleReverse&) const { return "spindle reverse"; }
     std::string operator()(const SpindleRestart&) const { return "spindle restart"; }
     std::string operator()(const SpindleCw&) const { return "spindle cw"; }

@@ -9,14 +9,6 @@ namespace interp {
 
 namespace {
 
-// Fixed-cycle variables a custom G code receives (FC-1): X Y Z R Q P F, K or L.
-struct FcWord {
-    char letter;
-    int fc;
-};
-constexpr FcWord kFcWords[] = {{'X', 1}, {'Y', 2}, {'Z', 3},  {'R', 4}, {'Q', 5},
-                               {'P', 6}, {'F', 7}, {'K', 11}, {'L', 11}};
-
 bool starts_with_slash(std::string_view line) {
     for (char c : line) {
         if (is_space(c)) continue;
@@ -156,9 +148,9 @@ void Interpreter::execute_line(const SourceLoc& loc) {
     customs_.clear();
     if (options_.s_hook_program && b.has('S') && !custom_code_active(kSHookCode)) queue_s_hook(b);
     if (library_) collect_custom_codes(b, flow.call.has_value());
-    bool custom_g = false;
-    for (const CustomCall& cc : customs_) custom_g = custom_g || cc.code >= kCustomGFlag;
-    if (custom_g) take_fixed_cycle_args(b);
+    cycles::CustomCycles cycles_next = custom_cycles_;
+    const std::optional<cycles::CustomCycles::Run> custom_run =
+        plan_custom_cycle(b, cycles_next);
     const Dialect& d = *options_.dialect;
     const std::size_t new_frames = (call_frame ? 1 : 0) + customs_.size();
     if (stack_.size() + new_frames > static_cast<std::size_t>(d.max_call_depth)) {
@@ -173,7 +165,8 @@ void Interpreter::execute_line(const SourceLoc& loc) {
         stack_.clear();
         return;
     }
-    if (custom_g) set_fixed_cycle_vars(loc);
+    custom_cycles_ = cycles_next;
+    if (custom_run) set_fixed_cycle_vars(*custom_run, loc);
 
     const SourcePos after_call = current_->tell();
     if (flow.ret) {
@@ -271,27 +264,59 @@ void Interpreter::queue_s_hook(const Block& b) {
     throw Error(b.loc_of('S'), "S hook subprogram O" + std::to_string(program) + " not found");
 }
 
-void Interpreter::take_fixed_cycle_args(Block& b) {
-    // A custom G code takes the block's address words as its arguments (#FC…); the other G and
-    // M codes act first, as for ISO G macros (CUS-5, MACG-2).
-    fc_args_ = {};
-    for (const FcWord& w : kFcWords) {
-        const int i = letter_index(w.letter);
-        if (b.words[i]) {
-            fc_args_[w.fc] = b.words[i];
-            b.words[i].reset();
+// Custom canned cycles (CC-19, FC-1/FC-2): the cycles core keeps their modal data; here the
+// block's cycle words become #FC values and the block's O(600+n) call is added (a bare position
+// re-runs the active cycle) or dropped (K0, no position). Blocks inside a running library cycle
+// are ordinary blocks.
+std::optional<cycles::CustomCycles::Run> Interpreter::plan_custom_cycle(
+    Block& b, cycles::CustomCycles& next) {
+    for (const CallFrame& f : stack_)
+        if (f.started && f.custom_code >= kCustomGFlag && f.custom_code < kSHookCode)
+            return std::nullopt;
+    cycles::CustomCycles::BlockInfo info;
+    std::size_t call = customs_.size();
+    for (std::size_t i = 0; i < customs_.size(); ++i)
+        if (customs_[i].code >= kCustomGFlag && customs_[i].code < kSHookCode) {
+            call = i;
+            info.custom_g = customs_[i].code - kCustomGFlag;
         }
+    for (const int g : {0, 10, 20, 30, 800}) info.cancels = info.cancels || b.has_g(g);
+    for (int n = 73; n <= 89; ++n) info.cancels = info.cancels || b.has_g(n * 10);
+    if (!info.custom_g && !next.active()) return std::nullopt;
+
+    const auto word = [&](char c) { return b.opt(c); };
+    info.words.axis_mm = {word('X'), word('Y'), word('Z')};
+    info.words.r_mm = word('R');
+    info.words.q_mm = word('Q');
+    info.words.p_ms = word('P');
+    info.words.k = b.has('K') ? word('K') : word('L');
+    info.f = word('F');
+    info.ctx.incremental = b.has_g(910) || (!b.has_g(900) && machine_.incremental_mode());
+    info.ctx.return_to_r = b.has_g(990) || (!b.has_g(980) && machine_.cycle_return_to_r());
+    const double unit = machine_.mm_per_program_unit();
+    for (int a = 0; a < 3; ++a) info.ctx.position_mm[a] = machine_.work_pos_mm(Axis(a)) / unit;
+    std::optional<cycles::CustomCycles::Run> run;
+    try {
+        run = next.block(info);
+    } catch (const cycles::CycleError& e) {
+        throw Error(b.loc, e.what());
     }
-    // The repeat count (K, or L as in S0 example 4) defaults to one run.
-    if (!fc_args_[11]) fc_args_[11] = 1.0;
+    if (!info.custom_g && !next.active()) return std::nullopt;  // cancelled by this block
+    // The cycle words belong to the library cycle, not to a move of this block.
+    for (const char c : {'X', 'Y', 'Z', 'R', 'Q', 'P', 'F', 'K', 'L'}) b.words[letter_index(c)].reset();
+    if (run && call == customs_.size()) {
+        const Dialect& d = *options_.dialect;
+        const std::int64_t program = d.custom_g_base + run->g;
+        if (const auto site = library_->find_label(program))
+            customs_.push_back(CustomCall{kCustomGFlag + run->g, program, *site, library_.get()});
+    } else if (!run && call < customs_.size()) {
+        customs_.erase(customs_.begin() + static_cast<std::ptrdiff_t>(call));
+    }
+    return run;
 }
 
-void Interpreter::set_fixed_cycle_vars(const SourceLoc& loc) {
-    for (std::size_t fc = 1; fc < fc_args_.size(); ++fc)
-        if (fc_args_[fc]) vars_.set_fixed_cycle(static_cast<int>(fc), *fc_args_[fc], loc);
-    vars_.set_fixed_cycle(12, machine_.cycle_return_to_r() ? 1.0 : 0.0, loc);
-    vars_.set_fixed_cycle(13, machine_.incremental_mode() ? 1.0 : 0.0, loc);
-    vars_.set_fixed_cycle(14, machine_.work_pos_mm(Axis::Z) / machine_.mm_per_program_unit(), loc);
+void Interpreter::set_fixed_cycle_vars(const cycles::CustomCycles::Run& run, const SourceLoc& loc) {
+    for (int fc = 1; fc <= 14; ++fc) vars_.set_fixed_cycle(fc, run.fc[fc], loc);
 }
 
 void Interpreter::handle_return(const ReturnRequest& r, const SourcePos& after_call) {
