@@ -250,19 +250,25 @@ struct SvgScan {
     std::string root;
     std::string width, height;
     int elements = 0;
-    std::vector<std::string> styles;
+    std::vector<std::string> styles;    // of the stroked elements (not the glyphs)
+    std::vector<std::size_t> vertices;  // M and L commands of each, in the same order
 };
 
 void on_start(void* data, const XML_Char* name, const XML_Char** attrs) {
     auto* scan = static_cast<SvgScan*>(data);
     if (scan->elements++ == 0) scan->root = name;
+    std::string style, d;
     for (int i = 0; attrs[i]; i += 2) {
         const std::string key = attrs[i], value = attrs[i + 1];
         if (scan->elements == 1 && key == "width") scan->width = value;
         if (scan->elements == 1 && key == "height") scan->height = value;
-        if (key == "style" && value.find("stroke:") != std::string::npos)
-            scan->styles.push_back(value);
+        if (key == "style") style = value;
+        if (key == "d") d = value;
     }
+    if (style.find("stroke:rgb") == std::string::npos) return;  // not a glyph (stroke:none)
+    scan->styles.push_back(style);
+    scan->vertices.push_back(
+        std::count_if(d.begin(), d.end(), [](char c) { return c == 'M' || c == 'L'; }));
 }
 
 // Parses the whole document; returns expat's error, or "" when the SVG is well-formed.
@@ -432,6 +438,35 @@ TEST(PreviewThinning, AlternatingKindsStayBoundedToo) {
     }
     EXPECT_LE(p.stored_points(), limits.max_points);
     EXPECT_NEAR(p.feed_length_mm(), 100'000, 1e-6);
+}
+
+TEST(PreviewThinning, SvgVerticesStayUnderTheCap) {
+    // 20 000 holes on a 0.7 x 0.9 mm grid, drilled by a feed down and a rapid up and over:
+    // far more distinct segments than the cap allows at a quarter pixel.
+    const PreviewLimits limits{400'000, 5000};
+    Preview p({MoveKind::Other, MoveKind::Rapid, MoveKind::Feed}, limits);
+    for (int i = 0; i < 20'000; ++i) {
+        const double x = (i % 150) * 0.7, y = (i / 150) * 0.9;
+        p.add({x, y, 2}, 1);
+        move(p, {x, y, 2}, {x, y, -1}, 2, 0.5);
+    }
+    ScratchDir dir;
+    const auto path = dir.path() / "holes.svg";
+    p.write(path.string(), {});
+    SvgScan scan;
+    ASSERT_EQ(parse_svg(slurp(path), scan), "");
+    std::size_t path_vertices = 0;
+    int rapids = 0;
+    for (std::size_t i = 0; i < scan.styles.size(); ++i) {
+        const Stroke s = stroke_of(scan.styles[i]);
+        if (s != Stroke::Other) path_vertices += scan.vertices[i];
+        rapids += s == Stroke::Rapid;
+    }
+    // The legend's two swatches (2 vertices each) come on top of the cap. Without the cap
+    // this program draws about 120 000.
+    EXPECT_LE(path_vertices, limits.max_svg_vertices + 4);
+    EXPECT_GT(path_vertices, limits.max_svg_vertices / 10) << "thinned far past the cap";
+    EXPECT_GE(rapids, 4);  // still drawn, in every view and the legend
 }
 
 TEST(PreviewThinning, StraightLinesAreNotStoredSampleBySample) {
