@@ -108,19 +108,17 @@ struct ViewSpec {
     const char* caption;
     // Screen right and screen up as combinations of X, Y, Z.
     std::array<double, 3> right, up;
-    const char* right_label;  // for the axis arrows of an orthographic view
-    const char* up_label;
-    int right_axis, up_axis;  // -1: not an orthographic view
+    int right_axis, up_axis;  // the model axes across and up; -1: not an orthographic view
 };
 
 // Third-angle projection: the right side view looks from +X, so +Y runs to the right. The
 // isometric view looks from the front right, above (direction (-1, 1, -1)).
 const double kR2 = 1 / std::sqrt(2.0), kR6 = 1 / std::sqrt(6.0);
 const ViewSpec kViews[] = {
-    {View::Top, "Top (XY)", {1, 0, 0}, {0, 1, 0}, "X", "Y", 0, 1},
-    {View::Front, "Front (XZ)", {1, 0, 0}, {0, 0, 1}, "X", "Z", 0, 2},
-    {View::Side, "Right (YZ)", {0, 1, 0}, {0, 0, 1}, "Y", "Z", 1, 2},
-    {View::Iso, "Isometric", {kR2, kR2, 0}, {-kR6, kR6, 2 * kR6}, "", "", -1, -1},
+    {View::Top, "Top (XY)", {1, 0, 0}, {0, 1, 0}, 0, 1},
+    {View::Front, "Front (XZ)", {1, 0, 0}, {0, 0, 1}, 0, 2},
+    {View::Side, "Right (YZ)", {0, 1, 0}, {0, 0, 1}, 1, 2},
+    {View::Iso, "Isometric", {kR2, kR2, 0}, {-kR6, kR6, 2 * kR6}, -1, -1},
 };
 
 Vec2 project(const ViewSpec& v, const Point& p) {
@@ -180,6 +178,12 @@ std::vector<Point> box_corners(const Point& lo, const Point& hi) {
 }
 
 // ---- drawing ------------------------------------------------------------------------------
+
+// What the samples span, and where they start and end; `any` is false for no sample at all.
+struct Extents {
+    Point lo, hi, start, end;
+    bool any;
+};
 
 struct Rgb {
     double r, g, b;
@@ -379,22 +383,20 @@ struct Scene {
     std::size_t vertices = 0;
 };
 
-Scene build_scene(const Preview& p, const Point& lo, const Point& hi, bool any,
-                  std::size_t max_vertices) {
+Scene build_scene(const Preview& p, const Extents& e, std::size_t max_vertices) {
     Scene scene;
-    std::vector<Point> all;
-    if (any) {
-        for (const auto& r : p.runs()) all.insert(all.end(), r.points.begin(), r.points.end());
-        all.push_back(lo);  // a lone sample leaves no run; its extents still place it
-        all.push_back(hi);
+    // An orthographic view's extents are exact from the samples' box; the isometric one needs
+    // the points themselves (the box's corners would leave room around the path).
+    std::vector<Point> points, corners;
+    if (e.any) {
+        for (const auto& r : p.runs())
+            points.insert(points.end(), r.points.begin(), r.points.end());
+        points.push_back(e.start);  // a lone sample is a run of one point: never drawn
+        corners = box_corners(e.lo, e.hi);
     }
-    for (const ViewSpec& spec : kViews) {
-        ViewDrawing d{&spec, {}, {}, {}};
-        // An orthographic view's extents are exact from the samples' box; the isometric one
-        // needs the points themselves (the box's corners would leave room around the path).
-        d.fit = fit_view(spec, spec.right_axis < 0 ? all : (any ? box_corners(lo, hi) : all));
-        scene.views.push_back(std::move(d));
-    }
+    for (const ViewSpec& spec : kViews)
+        scene.views.push_back(
+            {&spec, fit_view(spec, spec.right_axis < 0 ? points : corners), {}, {}});
     // Past kMaxTolerancePx the picture is a smear anyway: draw it rather than thin on.
     constexpr double kMaxTolerancePx = 64;
     for (;;) {
@@ -415,8 +417,7 @@ Scene build_scene(const Preview& p, const Point& lo, const Point& hi, bool any,
     }
 }
 
-void draw_panel(cairo_t* cr, const ViewDrawing& d, const Point& lo, const Point& hi, bool any,
-                const Point& start, const Point& end) {
+void draw_panel(cairo_t* cr, const ViewDrawing& d, const Extents& e) {
     const ViewSpec& v = *d.spec;
     const PixelBox panel = panel_box(v.view);
     set_colour(cr, kFrameColour);
@@ -426,13 +427,13 @@ void draw_panel(cairo_t* cr, const ViewDrawing& d, const Point& lo, const Point&
     set_colour(cr, kTextColour);
     text(cr, panel.x + 8, panel.y + 17, v.caption, 13, Align::Left, true);
     axis_arrows(cr, v, panel);
-    if (!any) {
+    if (!e.any) {
         set_colour(cr, kTextColour);
         text(cr, panel.x + panel.w / 2, panel.y + panel.h / 2, "no motion", 14, Align::Centre);
         return;
     }
     set_colour(cr, kTextColour);
-    text(cr, panel.x + 64, panel.y + panel.h - 10, extents_text(v, lo, hi), 11);
+    text(cr, panel.x + 64, panel.y + panel.h - 10, extents_text(v, e.lo, e.hi), 11);
     if (v.right_axis >= 0) scale_bar(cr, d.fit, panel);
     cairo_save(cr);
     // The path may reach a pixel past its box (line width, thinning): keep it off the footer.
@@ -443,7 +444,7 @@ void draw_panel(cairo_t* cr, const ViewDrawing& d, const Point& lo, const Point&
     cairo_set_line_cap(cr, CAIRO_LINE_CAP_BUTT);
     stroke(cr, d.feeds, MoveKind::Feed);
     stroke(cr, d.rapids, MoveKind::Rapid);
-    markers(cr, d.fit, v, start, end);
+    markers(cr, d.fit, v, e.start, e.end);
     cairo_restore(cr);
 }
 
@@ -657,10 +658,9 @@ void Preview::compact() {
 void Preview::write(const std::string& path, const PreviewCaption& caption) const {
     if (std::string why = preview_path_error(path); !why.empty()) throw std::runtime_error(why);
     const bool svg = lower_extension(path) == ".svg";
-    const bool any = samples_ > 0;
-    const Scene scene =
-        build_scene(*this, lo_, hi_, any,
-                    svg ? limits_.max_svg_vertices : std::numeric_limits<std::size_t>::max());
+    const Extents extents{lo_, hi_, start_, end_, samples_ > 0};
+    const Scene scene = build_scene(
+        *this, extents, svg ? limits_.max_svg_vertices : std::numeric_limits<std::size_t>::max());
     Surface surface(
         svg ? cairo_svg_surface_create(path.c_str(), kPictureWidthPx, kPictureHeightPx)
             : cairo_image_surface_create(CAIRO_FORMAT_RGB24, kPictureWidthPx, kPictureHeightPx));
@@ -671,7 +671,7 @@ void Preview::write(const std::string& path, const PreviewCaption& caption) cons
     cairo_paint(cr.get());
     set_colour(cr.get(), kTextColour);
     text(cr.get(), kMarginPx + 4, 30, title_text(*this, caption), 15, Align::Left, true);
-    for (const ViewDrawing& d : scene.views) draw_panel(cr.get(), d, lo_, hi_, any, start_, end_);
+    for (const ViewDrawing& d : scene.views) draw_panel(cr.get(), d, extents);
     legend(cr.get(), *this, scene);
     check(cairo_status(cr.get()), path);
     cr.reset();
