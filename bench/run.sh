@@ -84,31 +84,44 @@ if [[ $use_linuxcnc -eq 1 ]] && ! command -v linuxcnc >/dev/null; then
     use_linuxcnc=0
 fi
 
+# A program that fails on one side gets "failed" in that side's cells, its reason on stderr, and
+# the script exits 1 after printing the table.
+declare -A segments bound ours ratio seg_per_s ours_jerk run_motion speedup lcnc lcnc_note
+failures=0
+fail_note() {
+    echo "$0: $1 failed on $(rel "$2"):" >&2
+    printf '%s\n' "$3" | grep -v '^program,' | tail -n 3 | sed 's/^/    /' >&2
+    failures=$((failures + 1))
+}
+
 # Our planner alone: bench_motion plans each program through the real interpreter and samples
 # it at the servo period (CSV: program,jerk_mm_s3,segments,bound_s,motion_s,ratio,plan_seg_per_s).
 # (--jerk before --csv: a --jerk value list would swallow the program names that follow it.)
-declare -A segments bound ours ratio seg_per_s ours_jerk
 jerks=(--jerk 0)
 [[ $jerk_mm_s3 == 0 ]] || jerks+=(--jerk "$jerk_mm_s3")
-while IFS=, read -r prog jerk segs b m r s; do
-    [[ $prog == program ]] && continue
-    key=$(realpath "$prog")
-    if [[ $jerk != 0 ]]; then
-        ours_jerk[$key]=$m
+for prog in "${programs[@]}"; do
+    if ! csv=$("$bench_motion" "${jerks[@]}" --csv "$prog" 2>&1); then
+        fail_note bench_motion "$prog" "$csv"
+        ours[$prog]=failed
         continue
     fi
-    segments[$key]=$segs bound[$key]=$b ours[$key]=$m ratio[$key]=$r seg_per_s[$key]=$s
-done < <("$bench_motion" "${jerks[@]}" --csv "${programs[@]}")
+    while IFS=, read -r _ jerk segs b m r rate; do
+        if [[ $jerk != 0 ]]; then
+            ours_jerk[$prog]=$m
+        else
+            segments[$prog]=$segs bound[$prog]=$b ours[$prog]=$m ratio[$prog]=$r seg_per_s[$prog]=$rate
+        fi
+    done < <(printf '%s\n' "$csv" | grep -v '^program,')
+done
 
 # The whole machine: `cnc run --sim-clock` on bench/sim/bench.ini, timed on the wall clock.
-declare -A run_motion speedup lcnc lcnc_note
 for prog in "${programs[@]}"; do
     t0=$EPOCHREALTIME
-    summary=$("$cnc" run "$bench_dir"/sim/bench.ini "$prog" --sim-clock 2>&1) || {
-        echo "$0: cnc run failed on $(rel "$prog"):" >&2
-        printf '%s\n' "$summary" | tail -n 5 >&2
-        exit 1
-    }
+    if ! summary=$("$cnc" run "$bench_dir"/sim/bench.ini "$prog" --sim-clock 2>&1); then
+        fail_note "cnc run" "$prog" "$summary"
+        run_motion[$prog]=failed
+        continue
+    fi
     t1=$EPOCHREALTIME
     motion=$(printf '%s\n' "$summary" | sed -n 's/^motion time: \([0-9.]*\) s$/\1/p')
     run_motion[$prog]=$motion
@@ -124,7 +137,8 @@ if [[ $use_linuxcnc -eq 1 ]]; then
         times=()
         for ((rep = 0; rep < linuxcnc_reps; ++rep)); do
             echo "LinuxCNC: $(rel "$prog") run $((rep + 1))/$linuxcnc_reps ..." >&2
-            if ! result=$("$bench_dir"/linuxcnc/run.sh "$prog"); then
+            if ! result=$("$bench_dir"/linuxcnc/run.sh "$prog" 2>&1); then
+                fail_note LinuxCNC "$prog" "$result"
                 lcnc[$prog]=failed
                 continue 2
             fi
@@ -144,15 +158,18 @@ jerk_head="ours, jerk $jerk_mm_s3 s"
 [[ $jerk_mm_s3 == 0 ]] && jerk_head="ours, jerk-limited s"
 echo "| program | segments | bound s | ours s | ours/bound | cnc run s | LinuxCNC s | ours/LinuxCNC | plan seg/s | sim-clock x real time | $jerk_head |"
 echo "|---|---|---|---|---|---|---|---|---|---|---|"
+num() { [[ $2 =~ ^[0-9.e+-]+$ ]] && printf "$1" "$2" || printf '%s' "${2:--}"; }
 for prog in "${programs[@]}"; do
-    key=$(realpath "$prog")
+    o=${ours[$prog]}
     l=${lcnc[$prog]:-}
-    vs=""
-    [[ $l =~ ^[0-9.]+$ ]] && vs=$(awk -v a="${ours[$key]}" -v b="$l" 'BEGIN { printf "%.3f", a / b }')
-    j=${ours_jerk[$key]:-}
-    [[ -n $j ]] && j=$(awk -v a="$j" -v b="${ours[$key]}" 'BEGIN { printf "%.3f (%+.3f)", a, a - b }')
-    printf '| %s | %s | %.3f | %.3f | %.4f | %s | %s | %s | %.3g | %s | %s |\n' \
-        "$(basename "$prog")" "${segments[$key]}" "${bound[$key]}" "${ours[$key]}" \
-        "${ratio[$key]}" "${run_motion[$prog]}" "${l:--}${lcnc_note[$prog]:-}" "${vs:--}" \
-        "${seg_per_s[$key]}" "${speedup[$prog]}" "${j:--}"
+    vs=-
+    [[ $l =~ ^[0-9.]+$ && $o =~ ^[0-9.]+$ ]] && vs=$(awk -v a="$o" -v b="$l" 'BEGIN { printf "%.3f", a / b }')
+    j=${ours_jerk[$prog]:-}
+    [[ -n $j ]] && j=$(awk -v a="$j" -v b="$o" 'BEGIN { printf "%.3f (%+.3f)", a, a - b }')
+    printf '| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n' \
+        "$(basename "$prog")" "${segments[$prog]:--}" "$(num %.3f "${bound[$prog]:-}")" \
+        "$(num %.3f "$o")" "$(num %.4f "${ratio[$prog]:-}")" "${run_motion[$prog]:--}" \
+        "${l:--}${lcnc_note[$prog]:-}" "$vs" "$(num %.3g "${seg_per_s[$prog]:-}")" \
+        "${speedup[$prog]:--}" "${j:--}"
 done
+[[ $failures -eq 0 ]] || { echo "$0: $failures failed run(s), see above" >&2; exit 1; }
