@@ -155,6 +155,40 @@ TEST_F(SquarePng, NothingOfThePathOutsideThePanels) {
     EXPECT_EQ(find_hue(*png_, legend, Hue::Blue).count, 0);
 }
 
+TEST(PreviewArcs, CircleIsDrawnRoundWithoutVisibleFacets) {
+    // A full circle of radius 20 mm sampled every 0.02 mm (F1200 at 1 kHz). Seen from above,
+    // every blue pixel lies on the circle of 20 mm at the panel's scale, within the stroke's
+    // half width and antialiasing: facets or a lost arc would leave pixels off it.
+    Preview p({MoveKind::Other, MoveKind::Feed});
+    constexpr double kRadiusMm = 20;
+    const int n = static_cast<int>(2 * M_PI * kRadiusMm / 0.02);
+    for (int i = 0; i <= n; ++i) {
+        const double a = 2 * M_PI * i / n;
+        p.add({kRadiusMm * std::cos(a), kRadiusMm * std::sin(a), 0}, 1);
+    }
+    ScratchDir dir;
+    p.write((dir.path() / "circle.png").string(), {});
+    const Png png(dir.path() / "circle.png");
+    ASSERT_EQ(png.status(), CAIRO_STATUS_SUCCESS);
+    const auto plot = cncrun::plot_box(View::Top);
+    const double radius_px = kRadiusMm * scale(View::Top, 2 * kRadiusMm, 2 * kRadiusMm);
+    const double cx = plot.x + plot.w / 2, cy = plot.y + plot.h / 2;
+    const auto box = cncrun::panel_box(View::Top);
+    int blue = 0;
+    double worst = 0;
+    for (int y = static_cast<int>(box.y); y < static_cast<int>(box.y + box.h); ++y)
+        for (int x = static_cast<int>(box.x); x < static_cast<int>(box.x + box.w); ++x) {
+            if (hue(png.rgb(x, y)) != Hue::Blue) continue;
+            ++blue;
+            // Pixel centres: (x + 0.5, y + 0.5).
+            const double r = std::hypot(x + 0.5 - cx, y + 0.5 - cy);
+            worst = std::max(worst, std::abs(r - radius_px));
+        }
+    EXPECT_LE(worst, 1.5);
+    // About two pixels of stroke all the way round.
+    EXPECT_GT(blue, 2 * M_PI * radius_px * 1.5);
+}
+
 TEST(PreviewLengths, FeedAndRapidLengthsFromTheSamples) {
     Preview p(kSquareKinds);
     square_path(p);
