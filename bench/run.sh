@@ -79,8 +79,10 @@ if [[ $check_only -eq 1 ]]; then
     exit $failed
 fi
 
-if [[ $use_linuxcnc -eq 1 ]] && ! command -v linuxcnc >/dev/null; then
-    echo "LinuxCNC is not installed: its columns are left empty" >&2
+if [[ $use_linuxcnc -eq 1 ]] && { ! command -v linuxcnc >/dev/null ||
+    ! /usr/bin/python3 -c 'import linuxcnc' 2>/dev/null; }; then
+    echo "LinuxCNC 2.9 (linuxcnc-uspace and its python3 module) is not installed:" \
+        "its columns are left empty" >&2
     use_linuxcnc=0
 fi
 
