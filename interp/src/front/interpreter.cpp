@@ -1,5 +1,6 @@
 #include "interp/interpreter.hpp"
 
+#include <algorithm>
 #include <array>
 #include <string>
 
@@ -8,6 +9,14 @@
 namespace interp {
 
 namespace {
+
+// G codes that may stand in a block that re-runs an active custom cycle (×10, as in Block::g):
+// planes, units, distance mode, feed mode, return level.
+bool cycle_neutral_g(int g) {
+    constexpr std::array<int, 12> kNeutral = {170, 180, 190, 200, 210, 700,
+                                              710, 900, 910, 940, 980, 990};
+    return std::find(kNeutral.begin(), kNeutral.end(), g) != kNeutral.end();
+}
 
 bool starts_with_slash(std::string_view line) {
     for (char c : line) {
@@ -283,6 +292,12 @@ std::optional<cycles::CustomCycles::Run> Interpreter::plan_custom_cycle(
     for (const int g : {0, 10, 20, 30, 800}) info.cancels = info.cancels || b.has_g(g);
     for (int n = 73; n <= 89; ++n) info.cancels = info.cancels || b.has_g(n * 10);
     if (!info.custom_g && !next.active()) return std::nullopt;
+    if (!info.custom_g && !info.cancels) {
+        // While a custom cycle is active, only a block of positions and modal switches re-runs
+        // it; G04 P, G28 X, G92 X … keep their words, as with the built-in cycles.
+        for (const int g : b.g)
+            if (!cycle_neutral_g(g)) return std::nullopt;
+    }
 
     const auto word = [&](char c) { return b.opt(c); };
     info.words.axis_mm = {word('X'), word('Y'), word('Z')};
