@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 #include <variant>
 
@@ -23,8 +24,21 @@ motion::AxisArray to_axes(const interp::AxisVec& v) {
     return out;
 }
 
-// Turns canonical commands into planner input. Commands without a motion meaning for this
-// component (spindle, coolant, I/O, tool changes, waits, messages) are counted, not obeyed.
+constexpr char kLowerAxes[] = "xyzabcuvw";
+
+// The committed canon::SpindleOrient may not carry an angle yet; 0 degrees then.
+template <class Orient>
+double orient_angle_deg(const Orient& o) {
+    if constexpr (requires { o.tip_angle_deg; })
+        return o.tip_angle_deg;
+    else
+        return 0.0;
+}
+
+// Turns canonical commands into planner input. Machine commands (spindle, coolant, tool
+// change, outputs, waits, pauses) become action records after the motion before them has come
+// to rest; commands this machine has nothing for (messages, latches, G904, clamps) are counted
+// as ignored.
 class PlanSink final : public interp::CanonSink {
   public:
     PlanSink(motion::Planner& planner, const FeederConfig& cfg, ProgramFeeder& feeder)
@@ -76,6 +90,44 @@ class PlanSink final : public interp::CanonSink {
         planner_.finish();
         feeder_.collect();
     }
+    // G906 without a port: motion comes to rest before the program goes on.
+    void handle(const interp::SourceLoc&, const interp::canon::Sync&) {
+        planner_.finish();
+        feeder_.collect();
+    }
+    void handle(const interp::SourceLoc& loc, const interp::canon::SetSpindleSpeed& s) {
+        queue(loc, {motion::ActionKind::SpindleSpeed, false, 0, s.rpm});
+    }
+    void handle(const interp::SourceLoc& loc, const interp::canon::Spindle& s) {
+        const int dir = s.dir == interp::SpindleDir::Cw    ? 1
+                        : s.dir == interp::SpindleDir::Ccw ? -1
+                                                           : 0;
+        queue(loc, {motion::ActionKind::Spindle, false, dir, 0});
+    }
+    void handle(const interp::SourceLoc& loc, const interp::canon::SpindleOrient& o) {
+        queue(loc, {motion::ActionKind::SpindleOrient, false, 0, orient_angle_deg(o)});
+    }
+    void handle(const interp::SourceLoc& loc, const interp::canon::Coolant& c) {
+        queue(loc, {motion::ActionKind::Coolant, c.flood, 0, 0});
+    }
+    void handle(const interp::SourceLoc& loc, const interp::canon::ToolChange& t) {
+        queue(loc, {motion::ActionKind::ToolChange, false, t.tool, 0});
+    }
+    void handle(const interp::SourceLoc& loc, const interp::canon::SetToolNumber& t) {
+        queue(loc, {motion::ActionKind::SetToolNumber, false, t.tool, 0});
+    }
+    void handle(const interp::SourceLoc& loc, const interp::canon::SetOutput& o) {
+        check_port(loc, "M901", "output", "digital-out", o.port, cfg_.machine.digital_outputs);
+        queue(loc, {motion::ActionKind::SetOutput, o.level, o.port, 0});
+    }
+    void handle(const interp::SourceLoc& loc, const interp::canon::WaitInput& w) {
+        check_port(loc, "G906", "input", "digital-in", w.port, cfg_.machine.digital_inputs);
+        queue(loc, {motion::ActionKind::WaitInput, w.level, w.port, w.timeout_s});
+    }
+    void handle(const interp::SourceLoc& loc, const interp::canon::Stop& s) {
+        queue(loc, {s.optional ? motion::ActionKind::OptionalPause : motion::ActionKind::Pause,
+                    false, 0, 0});
+    }
     // Informational: end points already include offsets, units and plane are per move.
     void handle(const interp::SourceLoc&, const interp::canon::Offsets&) {}
     void handle(const interp::SourceLoc&, const interp::canon::ToolOffset&) {}
@@ -101,7 +153,42 @@ class PlanSink final : public interp::CanonSink {
         return seg;
     }
 
+    // The motion so far ends at rest, then the action's record stands in the queue.
+    void queue(const interp::SourceLoc& loc, const motion::Action& action) {
+        planner_.finish();
+        const motion::PreparedSegment rec = motion::action_record(pos_mm_, action, loc.line);
+        feeder_.collect(&rec);
+    }
+
+    static void check_port(const interp::SourceLoc& loc, const char* code, const char* what,
+                           const char* pin, int port, int count) {
+        if (port >= 0 && port < count) return;
+        throw std::runtime_error(
+            fmt::format("{}:{}:{}: {}: {} {} does not exist: the machine has motion.{}-00 to {:02} "
+                        "(num_dio={})",
+                        loc.file, loc.line, loc.col, code, what, port, pin, count - 1, count));
+    }
+
+    // LinuxCNC refuses a move whose path leaves the soft limits before it starts; so does this.
+    void check_soft_limits(const interp::SourceLoc& loc, const motion::PathSegment& seg) const {
+        const Extent reach = segment_reach(pos_mm_, seg);
+        constexpr double kSlack_mm = 1e-9;  // rounding of arc extremes computed from angles
+        for (int k = 0; k < motion::kAxes; ++k) {
+            if (!cfg_.axis_present[k]) continue;
+            const double lo = cfg_.machine.min_limit_mm[k], hi = cfg_.machine.max_limit_mm[k];
+            const bool low = reach.lo_mm[k] < lo - kSlack_mm;
+            if (!low && reach.hi_mm[k] <= hi + kSlack_mm) continue;
+            throw std::runtime_error(
+                fmt::format("{}:{}:{}: the move takes {} to {} mm, which exceeds the soft limit "
+                            "axis.{}.{}-limit = {} mm",
+                            loc.file, loc.line, loc.col, kAxisLetters[k],
+                            interp::fmt_num(low ? reach.lo_mm[k] : reach.hi_mm[k]), kLowerAxes[k],
+                            low ? "min" : "max", interp::fmt_num(low ? lo : hi)));
+        }
+    }
+
     void push(const interp::SourceLoc& loc, const motion::PathSegment& seg) {
+        check_soft_limits(loc, seg);
         try {
             planner_.push(seg);
         } catch (const motion::PlanError& e) {
@@ -123,7 +210,43 @@ class PlanSink final : public interp::CanonSink {
     double feed_mm_s_ = 0;
 };
 
+// Adds to `e` the points of the circle (centre c, radius r, in axes i, j) at the multiples of
+// 90 degrees that a sweep of `sweep` radians from angle `from` passes.
+void add_arc_extremes(Extent& e, int i, int j, double ci, double cj, double r, double from,
+                      double sweep) {
+    constexpr double kQuarter = std::numbers::pi / 2;
+    const double lo = std::min(from, from + sweep), hi = std::max(from, from + sweep);
+    for (double q = std::ceil(lo / kQuarter) * kQuarter; q <= hi; q += kQuarter) {
+        const int quadrant = static_cast<int>(std::lround(q / kQuarter)) & 3;
+        const double pi = ci + r * (quadrant == 0 ? 1 : quadrant == 2 ? -1 : 0);
+        const double pj = cj + r * (quadrant == 1 ? 1 : quadrant == 3 ? -1 : 0);
+        e.lo_mm[i] = std::min(e.lo_mm[i], pi);
+        e.hi_mm[i] = std::max(e.hi_mm[i], pi);
+        e.lo_mm[j] = std::min(e.lo_mm[j], pj);
+        e.hi_mm[j] = std::max(e.hi_mm[j], pj);
+    }
+}
+
 }  // namespace
+
+Extent segment_reach(const motion::AxisArray& start, const motion::PathSegment& seg) {
+    Extent e{seg.end_mm, seg.end_mm};
+    if (seg.kind != motion::SegmentKind::Arc || seg.turns == 0) return e;
+    const int i = seg.plane_first, j = seg.plane_second;
+    const double ci = seg.centre_mm[0], cj = seg.centre_mm[1];
+    const double from = std::atan2(start[j] - cj, start[i] - ci);
+    const double to = std::atan2(seg.end_mm[j] - cj, seg.end_mm[i] - ci);
+    // The planner may move the centre a little for an end slightly off the circle: take the
+    // larger radius so the box never comes out smaller than the path.
+    const double r = std::max(std::hypot(start[i] - ci, start[j] - cj),
+                              std::hypot(seg.end_mm[i] - ci, seg.end_mm[j] - cj));
+    constexpr double kTurn = 2 * std::numbers::pi;
+    double sweep = seg.turns > 0 ? to - from : from - to;  // in the direction of travel, >= 0
+    while (sweep <= 1e-12) sweep += kTurn;  // end == start in the plane: a full circle
+    sweep += (std::abs(seg.turns) - 1) * kTurn;
+    add_arc_extremes(e, i, j, ci, cj, r, from, seg.turns > 0 ? sweep : -sweep);
+    return e;
+}
 
 std::unique_ptr<interp::CanonSink> make_plan_sink(motion::Planner& planner, const FeederConfig& cfg,
                                                   ProgramFeeder& feeder) {

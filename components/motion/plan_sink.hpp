@@ -1,7 +1,10 @@
 // The canonical-command sink of the motion component: motion commands become planner
-// segments, dwells and program ends become records that hold still. Runs on the feeder thread.
+// segments; dwells, program ends and every machine command (spindle, coolant, tool change,
+// outputs, waits, pauses) become records that stand still in program order. Runs on the
+// feeder thread.
 #pragma once
 
+#include <array>
 #include <memory>
 
 #include "interp/canon.hpp"
@@ -12,7 +15,23 @@ namespace motioncomp {
 struct FeederConfig;
 class ProgramFeeder;
 
+// What the sink checks a program against, from the component's params at start().
+struct SinkConfig {
+    motion::AxisArray min_limit_mm{};  // soft limits per axis (LinuxCNC axis.L.min-limit)
+    motion::AxisArray max_limit_mm{};
+    int digital_outputs = 4;  // motion.digital-out-NN count (num_dio=)
+    int digital_inputs = 4;
+};
+
 std::unique_ptr<interp::CanonSink> make_plan_sink(motion::Planner& planner, const FeederConfig& cfg,
                                                   ProgramFeeder& feeder);
+
+// The axis-aligned box of the points a segment from `start_mm` reaches after its start: its end
+// and, for an arc, the extreme points of the circle it sweeps over. The start itself is left
+// out so that a machine outside its soft limits may move back in (as LinuxCNC allows).
+struct Extent {
+    motion::AxisArray lo_mm{}, hi_mm{};
+};
+Extent segment_reach(const motion::AxisArray& start_mm, const motion::PathSegment& seg);
 
 }  // namespace motioncomp
