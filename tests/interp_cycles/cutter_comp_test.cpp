@@ -342,6 +342,70 @@ TEST(CutterComp, CompensationOffPassesMovesThrough) {
     EXPECT_EQ(out, (Lines{"L 0,0 -> 5,0 plain #1", "A 5,0 -> 5,10 c5,5 ccw 180deg plain #2"}));
 }
 
+// ---- moves too short for the tool ------------------------------------------------
+
+TEST(CutterCompShortMoves, ChamferSmallerThanTheToolIsSkipped) {
+    // G41 (tool inside) along +X with a 0.5 chamfer (19.5,0)→(20,0.5) into +Y, r = 2. The
+    // chamfer's offset (its line moved 2 toward the pocket) meets y = 2 at x = 20.33, 0.33 beyond
+    // the chamfer's own offset: the tool cannot touch it. The +X and +Y offsets, y = 2 and x = 18,
+    // meet at (18, 2), which is |18 − 2 − 19.5|/√2 = 2.47 ≥ 2 from the chamfer: skipping it keeps
+    // exactly 2 from both walls and more than 2 from the chamfer.
+    Compensator c(Config{}, {5, 5});
+    EXPECT_EQ(run(c, {line(0, 0, L, 2, 1), line(19.5, 0, L, 2, 2), line(20, 0.5, L, 2, 3),
+                      line(20, 20, L, 2, 4), line(20, 25, Off, 2, 5)}),
+              (Lines{"L 5,5 -> 0,2 startup #1", "L 0,2 -> 18,2 contour #2",
+                     "L 18,2 -> 18,20 contour #4", "L 18,20 -> 20,25 cancel #5"}));
+}
+
+TEST(CutterCompShortMoves, StepSmallerThanTheToolGoesRoundItsCorner) {
+    // G41 (tool above) along +X, a 0.1 step up at x = 10, then +X again; r = 1. The step's
+    // offset x = 9 meets y = 1 at y-parameter 10 (beyond the step): skipped. The step's top
+    // corner (10, 0.1) turns right (outside), so the tool leaves y = 1 where it comes within 1 of
+    // that corner, x = 10 − √(1 − 0.9²) = 9.56411, and goes round it (clockwise, from 115.842° to
+    // 90°) to (10, 1.1) on the next move's offset.
+    Compensator c(Config{}, {0, -5});
+    EXPECT_EQ(run(c, {line(0, 0, L, 1, 1), line(10, 0, L, 1, 2), line(10, 0.1, L, 1, 3),
+                      line(20, 0.1, L, 1, 4), line(25, 0.1, Off, 1, 5)}),
+              (Lines{"L 0,-5 -> 0,1 startup #1", "L 0,1 -> 9.56411,1 contour #2",
+                     "A 9.56411,1 -> 10,1.1 c10,0.1 cw 25.8419deg corner #4",
+                     "L 10,1.1 -> 20,1.1 contour #4", "L 20,1.1 -> 25,0.1 cancel #5"}));
+}
+
+TEST(CutterCompShortMoves, SlotNarrowerThanTheToolIsAGouge) {
+    // +X, 0.2 up, −X back: a slot 0.2 wide for a tool of radius 1 on its inside. The first and
+    // last offsets, y = 1 and y = −0.8, never meet: no path keeps 1 from all three moves.
+    const CompError e =
+        error_of({line(0, 0, L, 1, 1), line(10, 0, L, 1, 2), line(10, 0.2, L, 1, 3),
+                  line(0, 0.2, L, 1, 4), line(0, 5, Off, 1, 5)},
+                 Config{}, {0, -5});
+    EXPECT_STREQ(e.what(),
+                 "cutter comp: gouge: the tool radius 1 does not fit the inside corner (with the "
+                 "move at line 2)");
+    EXPECT_EQ(e.at_block, 4);
+}
+
+TEST(CutterCompShortMoves, NoSkippingWithoutTheGougeCheck) {
+    // The chamfer of the first test: skipping is only safe when the gouge check proves it.
+    Config cfg;
+    cfg.gouge_check_moves = 0;
+    const CompError e =
+        error_of({line(0, 0, L, 2, 1), line(19.5, 0, L, 2, 2), line(20, 0.5, L, 2, 3),
+                  line(20, 20, L, 2, 4), line(20, 25, Off, 2, 5)},
+                 cfg);
+    EXPECT_STREQ(e.what(),
+                 "cutter comp: gouge: the tool radius 2 does not fit the inside corner (with the "
+                 "move at line 2)");
+    EXPECT_EQ(e.at_block, 3);
+}
+
+TEST(CutterCompShortMoves, ProgramEndingAfterASkippedMoveIsAGouge) {
+    // The program ends after the chamfer: nothing places its corner, so the tool cannot leave.
+    const CompError e =
+        error_of({line(0, 0, L, 2, 1), line(19.5, 0, L, 2, 2), line(20, 0.5, L, 2, 3)});
+    EXPECT_EQ(e.earlier_block, 2);
+    EXPECT_EQ(e.at_block, 3);
+}
+
 // ---- errors -----------------------------------------------------------------
 
 TEST(CutterCompErrors, StartOnAnArc) {

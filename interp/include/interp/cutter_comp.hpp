@@ -54,6 +54,11 @@
 
 namespace interp::cutter {
 
+namespace geom {
+struct Segment;  // offset_geometry.hpp, internal
+struct Curve;
+}  // namespace geom
+
 using Vec2 = Eigen::Vector2d;
 /// The executor's identifier of a block, normally its source line; opaque here.
 using SourceTag = std::int64_t;
@@ -197,6 +202,10 @@ class Compensator {
     void start_up(const Move& move);
     void finish_start_up(const Move& move);
     void join(const Move& move);
+    void join_after_skip(const geom::Segment& seg, const geom::Curve& next, const Move& move);
+    bool can_skip(const geom::Curve& next) const;
+    void skip(const geom::Segment& seg, const Move& move);
+    CompError corner_gouge(SourceTag earlier, SourceTag at) const;
     void link(const Move& move);
     void cancel(const Move& move);
     void end_pending_perpendicular();

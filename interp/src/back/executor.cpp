@@ -270,12 +270,19 @@ void Executor::end_of_input(const SourceLoc& loc) {
 void Executor::commit(ExecState&& st, std::optional<ProgramTransform>&& xf,
                       std::optional<Settings>&& settings, std::vector<Canon>& out) {
     const AxisVec machine_before = state_.pos.machine_mm;
+    // Cutter compensation finds its errors by look-ahead: staging it first lets a block it
+    // rejects commit nothing (CrcStage::stage changes nothing when it throws).
+    const bool through_crc = crc_.engaged() || st.crc.side != cutter::Side::Off;
+    if (through_crc) crc_.stage(out, st.crc, machine_before);
     state_ = st;
     if (xf) xf_ = std::move(*xf);
     const bool settings_changed = settings && !(*settings == settings_);
     if (settings) settings_ = std::move(*settings);
     if (settings_changed && settings_listener_) settings_listener_(settings_);
-    pass(out, machine_before);
+    if (through_crc)
+        crc_.emit_staged();
+    else
+        pass(out, machine_before);
 }
 
 void Executor::pass(std::vector<Canon>& out, const AxisVec& machine_before) {

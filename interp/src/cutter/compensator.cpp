@@ -85,6 +85,9 @@ struct Compensator::Pending {
     SourceTag on_tag{};              // the block that switched compensation (or its side) on
     std::vector<Recent> recent;      // the last contour moves, for the gouge check
     std::optional<Recent> upcoming;  // the move being joined, while its corner is emitted
+    // Moves after this one too short for the tool at an inside corner: they get no offset piece;
+    // the next move that leaves room joins this one directly (see join_after_skip).
+    std::vector<Recent> skipped;
 
     void become_contour(const Segment& s, const Curve& c, double u, const Move& m, SourceTag on,
                         std::size_t window) {
@@ -95,7 +98,12 @@ struct Compensator::Pending {
         move = m;
         on_tag = on;
         upcoming.reset();
-        recent.push_back(Recent{s, m.tag, bounds(s)});
+        skipped.clear();
+        remember(Recent{s, m.tag, bounds(s)}, window);
+    }
+
+    void remember(const Recent& r, std::size_t window) {
+        recent.push_back(r);
         if (recent.size() > window) recent.erase(recent.begin(), recent.end() - window);
     }
 };
@@ -370,6 +378,10 @@ void Compensator::join(const Move& move) {
     const Segment seg = Segment::make(programmed_, programmed_h_, move);
     const Curve next = offset_or_throw(seg, move, a.move.tag);
     a.upcoming = Pending::Recent{seg, move.tag, bounds(seg)};
+    if (!a.skipped.empty()) {
+        join_after_skip(seg, next, move);
+        return;
+    }
     const Vec2 t_in = a.seg.tangent(1.0);
     const Vec2 t_out = seg.tangent(0.0);
     const double turn_sin = geom::cross(t_in, t_out);
@@ -384,11 +396,11 @@ void Compensator::join(const Move& move) {
         // Inside corner: trim both offsets to their intersection nearest the
         // corner, which must lie within what is left of each move.
         const auto best = inside_joint(a.curve, a.u_start, next, seg.start);
-        if (!best)
-            throw CompError(fmt::format("cutter comp: gouge: the tool radius {:g} does not fit "
-                                        "the inside corner",
-                                        r),
-                            a.move.tag, move.tag);
+        if (!best) {
+            if (!can_skip(next)) throw corner_gouge(a.move.tag, move.tag);
+            skip(seg, move);
+            return;
+        }
         emit_piece(a.curve.piece(a.u_start, best->first), a.move.rapid, Role::Contour, a.move.tag);
         u_next = best->second;
     } else {
@@ -418,7 +430,95 @@ void Compensator::join(const Move& move) {
     a.become_contour(seg, next, u_next, move, a.on_tag, config_.gouge_check_moves);
 }
 
+CompError Compensator::corner_gouge(SourceTag earlier, SourceTag at) const {
+    return CompError(fmt::format("cutter comp: gouge: the tool radius {:g} does not fit the inside "
+                                 "corner",
+                                 pending_->move.radius_mm),
+                     earlier, at);
+}
+
+// A move is skipped when the offsets of the held move and of this one cross beyond this one's
+// end: the tool cannot touch it without cutting the held move. Only with the gouge check on,
+// which proves the tool then stays at least r from the skipped move (else: a gouge error).
+bool Compensator::can_skip(const Curve& next) const {
+    const Pending& a = *pending_;
+    if (config_.gouge_check_moves == 0 || a.skipped.size() >= config_.lookahead_moves ||
+        full_circle(next))
+        return false;
+    for (const Vec2& p : geom::intersections(a.curve, next)) {
+        const double ua = a.curve.param(p);
+        if (ua >= a.u_start - a.curve.tol_u() && ua <= 1.0 + a.curve.tol_u() &&
+            next.param(p) > 1.0 + next.tol_u())
+            return true;
+    }
+    return false;
+}
+
+void Compensator::skip(const Segment& seg, const Move& move) {
+    Pending& a = *pending_;
+    const Pending::Recent r{seg, move.tag, bounds(seg)};
+    a.skipped.push_back(r);
+    a.remember(r, config_.gouge_check_moves);
+    a.upcoming.reset();
+}
+
+// The held move meets the first move after the skipped ones. At an inside (or straight) corner
+// after the last skipped move their offsets are trimmed to their crossing; at an outside corner
+// the tool leaves the held move's offset where it comes within r of the corner point, and goes
+// round that point to the next move's offset (the transition circle of S2 §3.4.4).
+void Compensator::join_after_skip(const Segment& seg, const Curve& next, const Move& move) {
+    Pending& a = *pending_;
+    const Pending::Recent& last = a.skipped.back();
+    const Vec2 t_in = last.seg.tangent(1.0);
+    const Vec2 t_out = seg.tangent(0.0);
+    check_reversal(t_in, t_out, last.tag, move.tag);
+    const double turn_sin = geom::cross(t_in, t_out);
+    const double r = move.radius_mm;
+    double u_next = 0.0;
+    if (side_sign(move.side) * turn_sin > -kParallel) {
+        const auto best = inside_joint(a.curve, a.u_start, next, seg.start);
+        if (!best) {
+            if (!can_skip(next)) throw corner_gouge(a.move.tag, move.tag);
+            skip(seg, move);
+            return;
+        }
+        emit_piece(a.curve.piece(a.u_start, best->first), a.move.rapid, Role::Contour, a.move.tag);
+        u_next = best->second;
+    } else {
+        const Vec2 corner = seg.start;
+        std::optional<double> first;
+        Curve circle;
+        circle.shape = Shape::Arc;
+        circle.centre = corner;
+        circle.radius = r;
+        for (const Vec2& p : geom::intersections(a.curve, circle)) {
+            const double ua = a.curve.param(p);
+            if (ua >= a.u_start - a.curve.tol_u() && ua <= 1.0 + a.curve.tol_u() &&
+                (!first || ua < *first))
+                first = std::clamp(ua, a.u_start, 1.0);
+        }
+        if (!first) throw corner_gouge(a.move.tag, move.tag);
+        emit_piece(a.curve.piece(a.u_start, *first), a.move.rapid, Role::Contour, a.move.tag);
+        OutMove arc;
+        arc.shape = Shape::Arc;
+        arc.start = tool_;
+        arc.end = next.at(0.0);
+        arc.centre = corner;
+        arc.ccw = turn_sin > 0;
+        const Vec2 v0 = arc.start - corner, v1 = arc.end - corner;
+        double sweep = std::atan2(geom::cross(v0, v1), v0.dot(v1));
+        if (!arc.ccw) sweep = -sweep;
+        if (sweep < 0) sweep += 2.0 * std::numbers::pi;
+        arc.sweep_rad = sweep;
+        arc.start_h = arc.end_h = tool_h_;
+        emit_piece(arc, move.rapid, Role::Corner, move.tag);
+    }
+    flush_held();
+    a.become_contour(seg, next, u_next, move, a.on_tag, config_.gouge_check_moves);
+}
+
 void Compensator::cancel(const Move& move) {
+    if (!pending_->skipped.empty()) throw corner_gouge(pending_->move.tag, move.tag);
     if (move.shape == Shape::Arc)
         throw CompError(
             "cutter comp: compensation cannot be cancelled on an arc; cancel it with G00/G01",
@@ -452,6 +552,8 @@ void Compensator::cancel(const Move& move) {
 
 void Compensator::end_pending_perpendicular() {
     Pending& p = *pending_;
+    // Skipped moves need the next move to place the corner; there is none.
+    if (!p.skipped.empty()) throw corner_gouge(p.move.tag, current_tag_);
     switch (p.kind) {
         case Pending::Kind::StartUp: {
             const Vec2 t = p.seg.tangent(1.0);
