@@ -55,6 +55,20 @@ void eval_blend(const Element& e, double s, CurvePoint& out) {
     }
 }
 
+void eval_bezier(const Element& e, double s, CurvePoint& out) {
+    double L = e.length_mm;
+    double u = s / L, w = 1 - u;
+    double b0 = w * w * w, b1 = 3 * u * w * w, b2 = 3 * u * u * w, b3 = u * u * u;
+    for (int k = 0; k < kAxes; ++k) {
+        double p0 = e.origin[k], p1 = e.a[k], p2 = e.b[k], p3 = e.end[k];
+        double d0 = p1 - p0, d1 = p2 - p1, d2 = p3 - p2;
+        out.p[k] = b0 * p0 + b1 * p1 + b2 * p2 + b3 * p3;
+        out.d1[k] = 3 * (w * w * d0 + 2 * u * w * d1 + u * u * d2) / L;
+        out.d2[k] = 6 * (w * (d1 - d0) + u * (d2 - d1)) / (L * L);
+        out.d3[k] = 6 * (d2 - 2 * d1 + d0) / (L * L * L);
+    }
+}
+
 }  // namespace
 
 void evaluate(const Element& e, double s, CurvePoint& out) noexcept {
@@ -68,6 +82,9 @@ void evaluate(const Element& e, double s, CurvePoint& out) noexcept {
             break;
         case ElementKind::Blend:
             eval_blend(e, s, out);
+            break;
+        case ElementKind::Bezier:
+            eval_bezier(e, s, out);
             break;
     }
     if (s >= e.length_mm) out.p = e.end;  // the programmed end point, free of rounding
@@ -100,6 +117,19 @@ ElementBounds bounds(const Element& e) noexcept {
                 b.g1[k] = b.linear[k] = std::max(std::fabs(e.a[k]), std::fabs(t2));
                 b.g2[k] = 1.5 * std::fabs(e.b[k]) / two_l;
                 b.g3[k] = 6 * std::fabs(e.b[k]) / (two_l * two_l);
+            }
+            break;
+        }
+        case ElementKind::Bezier: {
+            // A Bezier curve's derivatives are Bezier curves too and stay within the hull of
+            // their control points.
+            double L = e.length_mm;
+            for (int k = 0; k < kAxes; ++k) {
+                double d0 = e.a[k] - e.origin[k], d1 = e.b[k] - e.a[k], d2 = e.end[k] - e.b[k];
+                b.g1[k] = b.linear[k] =
+                    3 * std::max({std::fabs(d0), std::fabs(d1), std::fabs(d2)}) / L;
+                b.g2[k] = 6 * std::max(std::fabs(d1 - d0), std::fabs(d2 - d1)) / (L * L);
+                b.g3[k] = 6 * std::fabs(d2 - 2 * d1 + d0) / (L * L * L);
             }
             break;
         }
@@ -186,6 +216,55 @@ Element make_blend(const AxisArray& corner, const AxisArray& t1, const AxisArray
         e.b[k] = t2[k] - t1[k];
         e.end[k] = corner[k] + l * t2[k];
     }
+    return e;
+}
+
+Element make_bezier(const AxisArray& p0, const AxisArray& p1, const AxisArray& p2,
+                    const AxisArray& p3) noexcept {
+    Element e;
+    e.kind = ElementKind::Bezier;
+    e.origin = p0;
+    e.a = p1;
+    e.b = p2;
+    e.end = p3;
+    double n0 = 0, n1 = 0, n2 = 0;
+    for (int k = 0; k < kAxes; ++k) {
+        n0 += (p1[k] - p0[k]) * (p1[k] - p0[k]);
+        n1 += (p2[k] - p1[k]) * (p2[k] - p1[k]);
+        n2 += (p3[k] - p2[k]) * (p3[k] - p2[k]);
+    }
+    e.length_mm = 3 * std::sqrt(std::max({n0, n1, n2}));
+    return e;
+}
+
+Element make_parabola(const AxisArray& corner, const AxisArray& t1, const AxisArray& t2,
+                      double l) noexcept {
+    AxisArray p0, p1, p2, p3;
+    for (int k = 0; k < kAxes; ++k) {
+        p0[k] = corner[k] - l * t1[k];
+        p3[k] = corner[k] + l * t2[k];
+        p1[k] = p0[k] + 2 * l / 3 * t1[k];
+        p2[k] = p3[k] - 2 * l / 3 * t2[k];
+    }
+    return make_bezier(p0, p1, p2, p3);
+}
+
+Element trim_arc(const Element& arc, double from, double to) noexcept {
+    Element e = arc;
+    double len = arc.length_mm;
+    double keep = std::max(0.0, len - from - to);
+    if (to > 0) {
+        CurvePoint cp;
+        evaluate(arc, len - to, cp);
+        e.end = cp.p;
+    }
+    // origin holds the centre in the plane and the start's values off it (c is zero in-plane).
+    double f0 = from / len;
+    for (int k = 0; k < kAxes; ++k) e.origin[k] = arc.origin[k] + f0 * arc.c[k];
+    e.theta0_rad = arc.theta0_rad + arc.sweep_rad * f0;
+    e.sweep_rad = arc.sweep_rad * keep / len;
+    for (int k = 0; k < kAxes; ++k) e.c[k] = arc.c[k] * keep / len;
+    e.length_mm = keep;
     return e;
 }
 

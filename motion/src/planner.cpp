@@ -1,5 +1,4 @@
 #include "motion/planner.hpp"
-#include "root.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -7,20 +6,39 @@
 #include <stdexcept>
 #include <string>
 
+#include "root.hpp"
+
 namespace motion {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kMinLength_mm = 1e-9;  // shorter moves are dropped as no motion
 constexpr double kTangentEps = 1e-12;   // max per-axis tangent difference treated as smooth
-// The blend's farthest point from the corner is (3/16) l |T2 - T1| (geometry.hpp).
+// The blend's largest distance from the programmed lines is (3/16) l sin(angle) (geometry.hpp).
 constexpr double kBlendDeviationPerL = 3.0 / 16.0;
+constexpr double kParabolaDeviationPerL = 1.0 / 4.0;
 // A kink whose allowed speed is below this fraction of the feed is taken as an exact stop.
 constexpr double kKinkStopFraction = 0.02;
 // Jerk-limited elements share one S-curve profile when their limits are within this ratio.
 constexpr double kJoinRatio = 0.8;
 constexpr double kJoinSpeedRatio = 0.999;
 constexpr std::size_t kMaxGroupItems = 256;
+// Corners with an arc are blended when sin(angle) is below this (sharper ones are stopped at).
+constexpr double kMaxArcBlendSin = 1.35;
+// Share of an arc a corner blend may take (less than half: an arc never vanishes).
+constexpr double kMaxArcTrimShare = 0.45;
+// Checking a blend with an arc: the blend is sampled at kDeviationSamples points against the
+// programmed moves' last and first kDeviationReach * l as kDeviationChords chords each; the
+// result must be within kDeviationMargin of the tolerance (the samples may miss the peak by a
+// little), else l shrinks by 0.7, at most kBlendAttempts times.
+constexpr int kDeviationSamples = 16;
+constexpr int kDeviationChords = 16;
+constexpr double kDeviationReach = 2;
+constexpr double kDeviationMargin = 0.95;
+constexpr int kBlendAttempts = 12;
+// With a jerk limit a Bezier blend (curvature steps at its ends) is used only if its ends can
+// be passed at this share of the feed.
+constexpr double kJerkBlendMinFeedShare = 0.25;
 
 bool finite_array(const AxisArray& a) {
     return std::all_of(a.begin(), a.end(), [](double x) { return std::isfinite(x); });
@@ -116,26 +134,34 @@ Planner::Junction Planner::classify(const Piece& p, const Piece& next) const {
         dnorm2 += dt[k] * dt[k];
     }
     const AxisLimits& lim = cfg_.limits;
-    double share = cfg_.junction_share, period = cfg_.servo_period_s;
-    // A step in curvature is a step in acceleration (v^2 times it); it matters only when jerk
-    // is limited, and then it may be junction_share of one period's jerk.
-    double curvature_cap = kInf;
-    for (int k = 0; k < kAxes && jerk_mode_; ++k) {
-        double step = std::fabs(ns.d2[k] - pe.d2[k]);
-        if (step > 1e-12 && lim.jerk_mm_s3[k] > 0)
-            curvature_cap =
-                std::min(curvature_cap, std::sqrt(share * lim.jerk_mm_s3[k] * period / step));
-    }
+    double curvature_cap = curvature_step_cap(pe.d2, ns.d2);
     if (dmax <= kTangentEps) return {curvature_cap, std::isfinite(curvature_cap), 0};
+    // The blends' distance from the programmed path grows with sin(angle) (geometry.hpp); past
+    // 90 degrees |T2 - T1| / sqrt(2) is used instead, so that a reversal does not spend half of
+    // each move on a slow turn.
+    double cos_angle = 1 - dnorm2 / 2;  // |T2 - T1|^2 = 2 - 2 cos(angle) for unit tangents
+    double sin_angle =
+        std::max(std::sqrt(std::max(0.0, 1 - cos_angle * cos_angle)), std::sqrt(dnorm2 / 2));
+    double feed =
+        std::min(p.feed_mm_s > 0 ? p.feed_mm_s : kInf, next.feed_mm_s > 0 ? next.feed_mm_s : kInf);
+    if (!std::isfinite(feed)) feed = *std::max_element(lim.vel_mm_s.begin(), lim.vel_mm_s.end());
     bool lines = p.geom.kind == ElementKind::Line && next.geom.kind == ElementKind::Line;
     if (lines && p.tolerance_mm > 0) {
         double l = std::min(p.geom.length_mm, next.geom.length_mm) / 2;
-        l = std::min(l, p.tolerance_mm / (kBlendDeviationPerL * std::sqrt(dnorm2)));
-        if (l > kMinLength_mm) return {kInf, false, l};
+        // Without a jerk limit the parabola (the per-axis bang-bang corner) is the fastest;
+        // its distance from the lines is (l / 4) sin(angle) (geometry.hpp).
+        if (!jerk_mode_) {
+            l = std::min(l, p.tolerance_mm / (kParabolaDeviationPerL * sin_angle));
+            if (l > kMinLength_mm) return {kInf, false, l, Blend::Parabola};
+        } else {
+            l = std::min(l, p.tolerance_mm / (kBlendDeviationPerL * sin_angle));
+            if (l > kMinLength_mm) return {kInf, false, l, Blend::Quartic};
+        }
     }
     // A kink that is not blended: pass it only as fast as a velocity step of junction_share of
     // one servo period's acceleration (and jerk) allows. For real corners that speed is next
     // to nothing, and stopping outright spares both neighbours the junction share.
+    double share = cfg_.junction_share, period = cfg_.servo_period_s;
     double cap = kInf;
     for (int k = 0; k < kAxes; ++k) {
         if (std::fabs(dt[k]) <= kTangentEps) continue;
@@ -144,29 +170,198 @@ Planner::Junction Planner::classify(const Piece& p, const Piece& next) const {
             step = std::min(step, share * lim.jerk_mm_s3[k] * period * period);
         cap = std::min(cap, step / std::fabs(dt[k]));
     }
-    double feed =
-        std::min(p.feed_mm_s > 0 ? p.feed_mm_s : kInf, next.feed_mm_s > 0 ? next.feed_mm_s : kInf);
-    if (!std::isfinite(feed)) feed = *std::max_element(lim.vel_mm_s.begin(), lim.vel_mm_s.end());
+    // Kinks with an arc (rounding in the program, or a real corner): a blend where passing
+    // the kink would cost speed.
+    if (cap < feed && p.tolerance_mm > 0 && sin_angle < kMaxArcBlendSin) {
+        Junction jn = bezier_corner(p, next, sin_angle, feed);
+        if (jn.blend_l_mm > 0) return jn;
+    }
     if (cap < kKinkStopFraction * feed) return {0, false, 0};
     return {std::min(cap, curvature_cap), true, 0};
+}
+
+double Planner::curvature_step_cap(const AxisArray& d2_before, const AxisArray& d2_after) const {
+    // A step in curvature is a step in acceleration (v^2 times it); it matters only when jerk
+    // is limited, and then it may be junction_share of one period's jerk.
+    double cap = kInf;
+    for (int k = 0; k < kAxes && jerk_mode_; ++k) {
+        double step = std::fabs(d2_after[k] - d2_before[k]);
+        if (step > 1e-12 && cfg_.limits.jerk_mm_s3[k] > 0)
+            cap = std::min(cap, std::sqrt(cfg_.junction_share * cfg_.limits.jerk_mm_s3[k] *
+                                          cfg_.servo_period_s / step));
+    }
+    return cap;
+}
+
+namespace {
+
+// Longest part of a move a corner blend may take: half of a line (the corner at its other end
+// may take the other half), a little less of an arc so that an arc never vanishes between two
+// blends.
+double max_trim_mm(const Element& e, double trimmed_start_mm) {
+    double left = e.length_mm - trimmed_start_mm;
+    return e.kind == ElementKind::Line ? std::min(left, e.length_mm / 2)
+                                       : std::min(left, e.length_mm * kMaxArcTrimShare);
+}
+
+Element trimmed(const Element& e, double from_mm, double to_mm) {
+    if (from_mm <= 0 && to_mm <= 0) return e;
+    return e.kind == ElementKind::Line ? trim_line(e, from_mm, to_mm) : trim_arc(e, from_mm, to_mm);
+}
+
+double dist2(const AxisArray& a, const AxisArray& b) {
+    double d = 0;
+    for (int k = 0; k < kAxes; ++k) d += (a[k] - b[k]) * (a[k] - b[k]);
+    return d;
+}
+
+// Squared distance from q to the segment [a, b].
+double segment_dist2(const AxisArray& q, const AxisArray& a, const AxisArray& b) {
+    double ab2 = dist2(a, b), t = 0;
+    if (ab2 > 0) {
+        for (int k = 0; k < kAxes; ++k) t += (q[k] - a[k]) * (b[k] - a[k]);
+        t = std::clamp(t / ab2, 0.0, 1.0);
+    }
+    double d = 0;
+    for (int k = 0; k < kAxes; ++k) {
+        double x = a[k] + t * (b[k] - a[k]) - q[k];
+        d += x * x;
+    }
+    return d;
+}
+
+// The piece [s0, s1] of e as a chain of chords, and how far the curve may bulge beyond them.
+struct Chords {
+    std::array<AxisArray, kDeviationChords + 1> pts;
+    double sagitta_mm = 0;
+};
+Chords chords(const Element& e, double s0, double s1) {
+    Chords c;
+    CurvePoint cp;
+    for (int i = 0; i <= kDeviationChords; ++i) {
+        evaluate(e, s0 + (s1 - s0) * i / kDeviationChords, cp);
+        c.pts[i] = cp.p;
+    }
+    if (e.kind == ElementKind::Arc) {
+        double h = (s1 - s0) / kDeviationChords;
+        c.sagitta_mm = h * h / (8 * e.radius_mm);
+    }
+    return c;
+}
+
+double chain_dist2(const AxisArray& q, const Chords& c) {
+    double best = kInf;
+    for (int i = 0; i < kDeviationChords; ++i)
+        best = std::min(best, segment_dist2(q, c.pts[i], c.pts[i + 1]));
+    return best;
+}
+
+// Largest distance of the blend from the two programmed moves near their corner (an upper
+// bound: only the parts near the corner are searched, and arcs are taken as chords plus their
+// bulge).
+double blend_deviation_mm(const Element& blend, const Chords& before, const Chords& after) {
+    double worst = 0;
+    CurvePoint cp;
+    for (int i = 1; i < kDeviationSamples; ++i) {
+        evaluate(blend, blend.length_mm * i / kDeviationSamples, cp);
+        worst = std::max(worst, std::min(chain_dist2(cp.p, before), chain_dist2(cp.p, after)));
+    }
+    return std::sqrt(worst) + std::max(before.sagitta_mm, after.sagitta_mm);
+}
+
+// Distance h of a Bezier blend's inner control points from its ends p0, p3 along the unit
+// tangents t1, t2. The blend's pseudo length is 3 h and its speed |p'| must be 1 at both ends
+// (no speed step at the junctions), so the middle of the hodograph may not be longer:
+// |p3 - p0 - h (t1 + t2)| <= h. h0 = 2/3 of the cut (the parabola, for two lines) when that
+// holds, else the smallest larger h that does; 0 if none.
+double control_distance_mm(const AxisArray& p0, const AxisArray& t1, const AxisArray& p3,
+                           const AxisArray& t2, double h0) {
+    double dd = 0, ds = 0, ss = 0;
+    for (int k = 0; k < kAxes; ++k) {
+        double d = p3[k] - p0[k], sk = t1[k] + t2[k];
+        dd += d * d, ds += d * sk, ss += sk * sk;
+    }
+    // f(h) = (ss - 1) h^2 - 2 ds h + dd <= 0
+    auto f = [&](double h) { return (ss - 1) * h * h - 2 * ds * h + dd; };
+    if (f(h0) <= 0) return h0;
+    const double qa = ss - 1, disc = ds * ds - qa * dd;
+    if (std::fabs(qa) < 1e-12) return ds > 0 ? std::max(h0, dd / (2 * ds)) : 0.0;
+    if (disc < 0) return 0;
+    double r1 = (ds - std::sqrt(disc)) / qa, r2 = (ds + std::sqrt(disc)) / qa;
+    for (double r : {std::min(r1, r2), std::max(r1, r2)})
+        if (r > h0 && f(r * (1 + 1e-12)) <= 1e-12 * dd) return r * (1 + 1e-12);
+    return 0;
+}
+
+}  // namespace
+
+Planner::Junction Planner::bezier_corner(const Piece& p, const Piece& next, double sin_angle,
+                                         double feed_mm_s) const {
+    const double tol = p.tolerance_mm;
+    double l_max = std::min(max_trim_mm(p.geom, p.trim_start_mm), max_trim_mm(next.geom, 0));
+    // For two lines the parabola's distance from them is exactly (l / 4) sin(angle); with an
+    // arc that is the first guess, checked and shrunk below.
+    double l = std::min(l_max, tol / (kParabolaDeviationPerL * sin_angle));
+    const double L1 = p.geom.length_mm;
+    double reach = std::min(l_max, kDeviationReach * l);
+    const Chords before = chords(p.geom, L1 - reach, L1);
+    const Chords after = chords(next.geom, 0, reach);
+    for (int attempt = 0; attempt < kBlendAttempts && l > kMinLength_mm; ++attempt, l *= 0.7) {
+        CurvePoint a, b;
+        evaluate(p.geom, L1 - l, a);
+        evaluate(next.geom, l, b);
+        double h = control_distance_mm(a.p, a.d1, b.p, b.d1, 2.0 / 3 * l);
+        if (!(h > 0)) continue;
+        AxisArray c1, c2;
+        for (int k = 0; k < kAxes; ++k) {
+            c1[k] = a.p[k] + h * a.d1[k];
+            c2[k] = b.p[k] - h * b.d1[k];
+        }
+        Junction jn{kInf, false, l, Blend::Curve};
+        jn.curve = make_bezier(a.p, c1, c2, b.p);
+        if (blend_deviation_mm(jn.curve, before, after) > kDeviationMargin * tol) continue;
+        jn.curve_end_cap_mm_s = kInf;
+        if (!jerk_mode_) return jn;  // without a jerk limit curvature steps cost nothing
+        EndDerivs bs = start_derivs(jn.curve), be = end_derivs(jn.curve);
+        jn.cap_mm_s = curvature_step_cap(a.d2, bs.d2);
+        jn.rough = std::isfinite(jn.cap_mm_s);
+        jn.curve_end_cap_mm_s = curvature_step_cap(be.d2, b.d2);
+        jn.curve_end_rough = std::isfinite(jn.curve_end_cap_mm_s);
+        // The steps make the neighbours give up the junction share: only worth it when the
+        // corner can then be taken at a good part of the feed.
+        if (std::min(jn.cap_mm_s, jn.curve_end_cap_mm_s) < kJerkBlendMinFeedShare * feed_mm_s)
+            return {0, false, 0};
+        return jn;
+    }
+    return {0, false, 0};
 }
 
 void Planner::close_piece(Piece& p, Piece* next) {
     Junction jn = next ? classify(p, *next) : Junction{0, false, 0};
     bool rough = p.rough_start || jn.rough;
-    if (p.geom.kind == ElementKind::Line) {
-        Element e = trim_line(p.geom, p.trim_start_mm, jn.blend_l_mm);
-        // Only a line blended at both ends can vanish, and its junctions are smooth.
-        if (e.length_mm > kMinLength_mm) add_item(e, p.feed_mm_s, jn.cap_mm_s, rough, p.line);
-    } else {
-        add_item(p.geom, p.feed_mm_s, jn.cap_mm_s, rough, p.line);
-    }
+    Element e = trimmed(p.geom, p.trim_start_mm, jn.blend_l_mm);
+    // Only a line blended at both ends can vanish, and its junctions are smooth.
+    if (e.length_mm > kMinLength_mm) add_item(e, p.feed_mm_s, jn.cap_mm_s, rough, p.line);
     if (!next) return;
-    if (jn.blend_l_mm > 0) {
-        double f1 = p.feed_mm_s, f2 = next->feed_mm_s;
-        double feed = f1 > 0 && f2 > 0 ? std::min(f1, f2) : std::max(f1, f2);
-        Element blend = make_blend(p.geom.end, p.geom.a, next->geom.a, jn.blend_l_mm);
-        add_item(blend, feed, kInf, false, next->line);
+    double f1 = p.feed_mm_s, f2 = next->feed_mm_s;
+    double feed = f1 > 0 && f2 > 0 ? std::min(f1, f2) : std::max(f1, f2);
+    switch (jn.blend) {
+        case Blend::Curve:
+            add_item(jn.curve, feed, jn.curve_end_cap_mm_s, jn.rough || jn.curve_end_rough,
+                     next->line);
+            next->trim_start_mm = jn.blend_l_mm;
+            next->rough_start = jn.curve_end_rough;
+            return;
+        case Blend::Parabola:
+            add_item(make_parabola(p.geom.end, p.geom.a, next->geom.a, jn.blend_l_mm), feed, kInf,
+                     false, next->line);
+            break;
+        case Blend::Quartic:
+            add_item(make_blend(p.geom.end, p.geom.a, next->geom.a, jn.blend_l_mm), feed, kInf,
+                     false, next->line);
+            break;
+        case Blend::None:
+            break;
     }
     next->trim_start_mm = jn.blend_l_mm;
     next->rough_start = jn.rough;

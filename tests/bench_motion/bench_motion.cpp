@@ -155,22 +155,23 @@ struct Row {
 void print_row_text(const Row& r, double base_s) {
     std::string label = r.jerk > 0 ? fmt::format("jerk {:g} mm/s^3", r.jerk) : "jerk unlimited";
     double motion_s = r.run.sampled_s;
-    fmt::print("{} {}: {} segments, motion time {:.3f} s (planned {:.4f} s), bound {:.3f} s, "
-               "ratio {:.4f}",
-               r.program, label, r.segments, motion_s, r.run.planned_s, r.bound_s,
-               motion_s / r.bound_s);
+    fmt::print(
+        "{} {}: {} segments, motion time {:.3f} s (planned {:.4f} s), bound {:.3f} s, "
+        "ratio {:.4f}",
+        r.program, label, r.segments, motion_s, r.run.planned_s, r.bound_s, motion_s / r.bound_s);
     if (r.jerk > 0 && base_s > 0) fmt::print(", extra {:+.3f} s vs unlimited", motion_s - base_s);
-    fmt::print("\n  max |v| xyz {:.2f} {:.2f} {:.2f} mm/s, max |a| xyz {:.1f} {:.1f} {:.1f} mm/s^2, "
-               "end error {:.2e} mm",
-               r.run.max_vel[0], r.run.max_vel[1], r.run.max_vel[2], r.run.max_acc[0],
-               r.run.max_acc[1], r.run.max_acc[2], r.run.end_error_mm);
+    fmt::print(
+        "\n  max |v| xyz {:.2f} {:.2f} {:.2f} mm/s, max |a| xyz {:.1f} {:.1f} {:.1f} mm/s^2, "
+        "end error {:.2e} mm",
+        r.run.max_vel[0], r.run.max_vel[1], r.run.max_vel[2], r.run.max_acc[0], r.run.max_acc[1],
+        r.run.max_acc[2], r.run.end_error_mm);
     if (r.seg_per_s > 0) fmt::print(", planning {:.3g} segments per CPU second", r.seg_per_s);
     fmt::print("\n");
 }
 
 void print_row_csv(const Row& r) {
-    fmt::print("{},{:g},{},{:.4f},{:.4f},{:.4f},{:.0f}\n", r.program, r.jerk, r.segments,
-               r.bound_s, r.run.sampled_s, r.run.sampled_s / r.bound_s, r.seg_per_s);
+    fmt::print("{},{:g},{},{:.4f},{:.4f},{:.4f},{:.0f}\n", r.program, r.jerk, r.segments, r.bound_s,
+               r.run.sampled_s, r.run.sampled_s / r.bound_s, r.seg_per_s);
 }
 
 // The smoke run must at least end where the program ends, within the limits.
@@ -194,7 +195,8 @@ int main(int argc, char** argv) {
     bool smoke = false, csv = false;
     int excess = 0;
     double min_cpu_s = 0.5;
-    app.add_option("programs", programs, "G-code files (default: tests/bench_motion/tp_default.ngc)");
+    app.add_option("programs", programs,
+                   "G-code files (default: tests/bench_motion/tp_default.ngc)");
     app.add_option("--jerk", jerks, "jerk limit to run, mm/s^3 (0 = unlimited; repeatable)")
         ->expected(1)
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
@@ -217,12 +219,14 @@ int main(int argc, char** argv) {
     if (jerks.empty() || smoke) jerks = {0};
 
     try {
-        if (csv) fmt::print("program,jerk_mm_s3,segments,bound_s,motion_s,ratio,plan_seg_per_s\n");
+        if (csv)
+            fmt::print("program,jerk_mm_s3,segments,bound_s,motion_s,ratio,plan_seg_per_s\n");
         else
-            fmt::print("settings: {} mm/s, {} mm/s^2 per axis, servo {} Hz, default G64 P{}, "
-                       "reserve {}, junction share {}\n",
-                       s.vel_mm_s, s.acc_mm_s2, 1 / s.period_s, s.tolerance_mm, s.reserve,
-                       s.junction_share);
+            fmt::print(
+                "settings: {} mm/s, {} mm/s^2 per axis, servo {} Hz, default G64 P{}, "
+                "reserve {}, junction share {}\n",
+                s.vel_mm_s, s.acc_mm_s2, 1 / s.period_s, s.tolerance_mm, s.reserve,
+                s.junction_share);
         for (const std::string& program : programs) {
             bench::BenchProgram prog = bench::read_program(program, s.tolerance_mm);
             if (prog.segments.empty()) throw std::runtime_error(program + ": no moves");

@@ -24,7 +24,8 @@ AxisArray to_axes(const interp::AxisVec& v) {
 // changes, messages) are skipped, as the bench measures motion only.
 class SegmentSink final : public interp::CanonSink {
   public:
-    SegmentSink(BenchProgram& prog, double tolerance_mm) : prog_(prog), tolerance_mm_(tolerance_mm) {}
+    SegmentSink(BenchProgram& prog, double tolerance_mm)
+        : prog_(prog), tolerance_mm_(tolerance_mm) {}
 
     void emit(const interp::Canon& c) override {
         std::visit([&](const auto& cmd) { handle(c.loc, cmd); }, c.cmd);

@@ -39,6 +39,26 @@ void check_derivatives(const Element& e) {
     }
 }
 
+// max(sin(angle), |T2 - T1| / sqrt(2)) for unit tangents with |T2 - T1|^2 = dt2.
+double corner_sine(double dt2) {
+    double c = 1 - dt2 / 2;
+    return std::max(std::sqrt(std::max(0.0, 1 - c * c)), std::sqrt(dt2 / 2));
+}
+
+// Distance from p to the corner's two rays (in along -t1 from the corner, out along t2).
+double rays_distance(const AxisArray& p, const AxisArray& corner, const AxisArray& t1,
+                     const AxisArray& t2) {
+    auto ray = [&](const AxisArray& t, double sign) {
+        double along = 0;
+        for (int k = 0; k < kAxes; ++k) along += (p[k] - corner[k]) * t[k] * sign;
+        along = std::max(0.0, along);
+        AxisArray foot;
+        for (int k = 0; k < kAxes; ++k) foot[k] = corner[k] + sign * along * t[k];
+        return dist(p, foot);
+    };
+    return std::min(ray(t1, -1), ray(t2, 1));
+}
+
 TEST(Geometry, QuarterArcG17HasRightLengthEndsAndUnitSpeed) {
     PathSegment seg;
     seg.kind = SegmentKind::Arc;
@@ -136,6 +156,9 @@ TEST(Geometry, BlendStaysWithinItsDeviationAndJoinsTangentially) {
         double dt = 0;
         for (int k = 0; k < kAxes; ++k) dt += (t2[k] - t1[k]) * (t2[k] - t1[k]);
         double max_dev = 3.0 / 16.0 * l * std::sqrt(dt);
+        // What the planner relies on: the distance from the path is at most (3/16) l sin(angle)
+        // up to 90 degrees and (3/16) l |T2 - T1| / sqrt(2) beyond.
+        double path_dev = 3.0 / 16.0 * l * corner_sine(dt);
         EndDerivs s = start_derivs(b), e = end_derivs(b);
         for (int k = 0; k < kAxes; ++k) {
             EXPECT_NEAR(s.tangent[k], t1[k], 1e-12);
@@ -156,7 +179,7 @@ TEST(Geometry, BlendStaysWithinItsDeviationAndJoinsTangentially) {
                 return dist(cp.p, foot);
             };
             double d = std::min(ray(t1, -1), ray(t2, 1));
-            ASSERT_LE(d, max_dev + 1e-12);
+            ASSERT_LE(d, path_dev + 1e-12);
             double speed = 0;
             for (double x : cp.d1) speed += x * x;
             ASSERT_LE(std::sqrt(speed), 1 + 1e-12);
@@ -164,6 +187,69 @@ TEST(Geometry, BlendStaysWithinItsDeviationAndJoinsTangentially) {
         CurvePoint mid;
         evaluate(b, l, mid);
         EXPECT_NEAR(dist(mid.p, corner), max_dev, 1e-12);
+    }
+}
+
+// The planner's corner without a jerk limit: a cubic with the parabola's control points.
+TEST(Geometry, ParabolicBezierBlendStaysWithinQuarterLSineAndHasUnitEndSpeed) {
+    std::mt19937_64 rng(5);
+    std::normal_distribution<double> n(0, 1);
+    for (int trial = 0; trial < 500; ++trial) {
+        AxisArray t1{}, t2{}, corner{};
+        double n1 = 0, n2 = 0;
+        for (int k = 0; k < 4; ++k) {
+            t1[k] = n(rng), t2[k] = n(rng), corner[k] = 10 * n(rng);
+            n1 += t1[k] * t1[k], n2 += t2[k] * t2[k];
+        }
+        for (int k = 0; k < 4; ++k) t1[k] /= std::sqrt(n1), t2[k] /= std::sqrt(n2);
+        double l = 0.05 + std::fabs(n(rng));
+        Element b = make_parabola(corner, t1, t2, l);
+        EXPECT_NEAR(b.length_mm, 2 * l, 1e-12);
+        check_derivatives(b);
+        double dt = 0;
+        for (int k = 0; k < kAxes; ++k) dt += (t2[k] - t1[k]) * (t2[k] - t1[k]);
+        EndDerivs s = start_derivs(b), e = end_derivs(b);
+        for (int k = 0; k < kAxes; ++k) {
+            EXPECT_NEAR(s.tangent[k], t1[k], 1e-12);
+            EXPECT_NEAR(e.tangent[k], t2[k], 1e-12);
+            // constant second derivative: the per-axis bang-bang corner
+            EXPECT_NEAR(s.d2[k], (t2[k] - t1[k]) / (2 * l), 1e-9);
+            EXPECT_NEAR(e.d2[k], (t2[k] - t1[k]) / (2 * l), 1e-9);
+        }
+        double worst = 0;
+        for (int i = 0; i <= 200; ++i) {
+            CurvePoint cp;
+            evaluate(b, b.length_mm * i / 200, cp);
+            worst = std::max(worst, rays_distance(cp.p, corner, t1, t2));
+            double speed = 0;
+            for (double x : cp.d1) speed += x * x;
+            ASSERT_LE(std::sqrt(speed), 1 + 1e-12);
+        }
+        EXPECT_LE(worst, l / 4 * corner_sine(dt) + 1e-12);
+    }
+}
+
+TEST(Geometry, TrimmedHelixFollowsTheOriginal) {
+    PathSegment seg;
+    seg.kind = SegmentKind::Arc;
+    seg.plane_first = 2, seg.plane_second = 0, seg.plane_normal = 1;  // G18
+    seg.end_mm = {3, 4, 0, 30};  // Y and A move linearly: a helix with a rotary axis
+    seg.centre_mm = {0, 0};      // (Z, X)
+    seg.turns = -2;
+    Element arc = make_arc({3, 0, 0, 0}, seg);
+    const double from = 0.7, to = 1.3;
+    Element t = trim_arc(arc, from, to);
+    EXPECT_NEAR(t.length_mm, arc.length_mm - from - to, 1e-12);
+    for (int i = 0; i <= 50; ++i) {
+        double s = t.length_mm * i / 50;
+        CurvePoint a, b;
+        evaluate(arc, from + s, a);
+        evaluate(t, s, b);
+        for (int k = 0; k < kAxes; ++k) {
+            ASSERT_NEAR(a.p[k], b.p[k], 1e-9) << "s " << s << " axis " << k;
+            ASSERT_NEAR(a.d1[k], b.d1[k], 1e-9);
+            ASSERT_NEAR(a.d2[k], b.d2[k], 1e-9);
+        }
     }
 }
 

@@ -126,26 +126,174 @@ TEST(Planner, CollinearMovesDoNotStop) {
     EXPECT_NEAR(recs[0].profile.at(recs[0].profile.duration_s).v_mm_s, 50, 1e-9);
 }
 
-TEST(Planner, BlendedRightAngleKeepsSpeedAndStaysWithinTolerance) {
+// Largest distance of a record's path from the corner (10, 0) of the lines (0,0)-(10,0)-(10,10).
+double right_angle_deviation(const PreparedSegment& rec) {
+    double worst = 0;
+    for (int i = 0; i <= 2000; ++i) {
+        MotionSample s = sample(rec, rec.profile.duration_s * i / 2000);
+        double to_first = s.pos_mm[0] <= 10 ? std::fabs(s.pos_mm[1]) : 1e9;
+        double to_second = s.pos_mm[1] >= 0 ? std::fabs(s.pos_mm[0] - 10) : 1e9;
+        worst = std::max(worst, std::min(to_first, to_second));
+    }
+    return worst;
+}
+
+TEST(Planner, BlendedRightAngleIsTheParabolaWithoutJerkLimit) {
     PlannerConfig cfg = uniform(100, 1000, 0);
     const double tol = 0.01;
     auto recs = plan(cfg, {line_to({10}, 50, tol, 0), line_to({10, 10}, 50, tol, 1)});
     ASSERT_EQ(recs.size(), 3u);
+    ASSERT_EQ(recs[1].geom.kind, ElementKind::Bezier);
+    // The parabola from l before to l after the corner is (l / 4) sin(90 deg) from the lines at
+    // its middle: l = 4 tol. Its pseudo length is 2 l.
+    double l = 4 * tol;
+    EXPECT_NEAR(recs[1].geom.length_mm, 2 * l, 1e-12);
+    EXPECT_NEAR(recs[0].geom.length_mm, 10 - l, 1e-12);
+    // Constant acceleration |dT_k| / 2l v^2 per axis against the blend's centripetal share
+    // (0.95) of the usable acceleration (900): the bang-bang corner.
+    double v = std::sqrt(0.95 * 900 * 2 * l);
+    EXPECT_NEAR(recs[1].profile.peak_v_mm_s, v, 1e-9);
+    MotionSample mid = sample(recs[1], recs[1].profile.duration_s / 2);
+    EXPECT_NEAR(mid.acc_mm_s2[0], -0.95 * 900, 1e-6);
+    EXPECT_NEAR(mid.acc_mm_s2[1], 0.95 * 900, 1e-6);
+    EXPECT_NEAR(right_angle_deviation(recs[1]), tol, 1e-6);
+}
+
+TEST(Planner, BlendedRightAngleIsTheQuarticWithJerkLimit) {
+    PlannerConfig cfg = uniform(100, 1000, 1e9);  // a jerk limit too high to bind here
+    const double tol = 0.01;
+    auto recs = plan(cfg, {line_to({10}, 50, tol, 0), line_to({10, 10}, 50, tol, 1)});
+    ASSERT_EQ(recs.size(), 3u);
     ASSERT_EQ(recs[1].geom.kind, ElementKind::Blend);
-    // Cut per side: l = tol / ((3/16) |T2 - T1|) with |T2 - T1| = sqrt(2).
-    double l = tol / (3.0 / 16.0 * std::sqrt(2.0));
+    // Cut per side: l = tol / ((3/16) sin(90 deg)).
+    double l = tol / (3.0 / 16.0);
     EXPECT_NEAR(recs[1].geom.length_mm, 2 * l, 1e-12);
     // Speed through it: the axis curvature bound 1.5 |dT_k| / 2l with |dT_k| = 1 against the
     // blend's centripetal share (0.95) of the usable acceleration.
     double v = std::sqrt(0.95 * 900 * 2 * l / 1.5);
     EXPECT_NEAR(recs[1].profile.peak_v_mm_s, v, 1e-9);
-    // Closest approach to the corner is the tolerance.
-    double best = 1e9;
-    for (int i = 0; i <= 1000; ++i) {
-        MotionSample s = sample(recs[1], recs[1].profile.duration_s * i / 1000);
-        best = std::min(best, std::hypot(s.pos_mm[0] - 10, s.pos_mm[1]));
+    EXPECT_NEAR(right_angle_deviation(recs[1]), tol, 1e-6);
+}
+
+PathSegment arc_to(AxisArray end, std::array<double, 2> centre, int turns, double feed, double tol,
+                   int line) {
+    PathSegment s = line_to(end, feed, tol, line);
+    s.kind = SegmentKind::Arc;
+    s.centre_mm = centre;
+    s.turns = turns;
+    return s;
+}
+
+struct CornerReport {
+    double worst_dev_mm = 0;     // largest distance from the programmed moves
+    double worst_acc_ratio = 0;  // largest |a_k| / limit
+    double worst_vel_ratio = 0;
+    double worst_jerk_ratio = 0;  // with a jerk limit
+    int stops = 0;                // records other than the last ending at rest
+    int beziers = 0;
+};
+
+// Samples every record `samples` times against the programmed moves (segment line = index) and
+// the limits; inside a blend (tagged with the next move) the previous move counts too.
+CornerReport check_corners(const PlannerConfig& cfg, const test::Program& prog,
+                           const std::vector<PreparedSegment>& recs, int samples = 200) {
+    std::vector<Element> elems = test::programmed_elements(prog);
+    CornerReport rep;
+    for (std::size_t r = 0; r < recs.size(); ++r) {
+        const PreparedSegment& rec = recs[r];
+        rep.beziers += rec.geom.kind == ElementKind::Bezier;
+        if (r + 1 < recs.size() && rec.profile.at(rec.profile.duration_s).v_mm_s < 1e-9)
+            ++rep.stops;
+        for (int i = 0; i <= samples; ++i) {
+            MotionSample s = sample(rec, rec.profile.duration_s * i / samples);
+            auto line = static_cast<std::size_t>(rec.line);
+            double d = test::distance_to(elems[line], s.pos_mm);
+            if (line > 0) d = std::min(d, test::distance_to(elems[line - 1], s.pos_mm));
+            rep.worst_dev_mm = std::max(rep.worst_dev_mm, d);
+            for (int k = 0; k < kAxes; ++k) {
+                rep.worst_acc_ratio = std::max(rep.worst_acc_ratio,
+                                               std::fabs(s.acc_mm_s2[k]) / cfg.limits.acc_mm_s2[k]);
+                rep.worst_vel_ratio = std::max(rep.worst_vel_ratio,
+                                               std::fabs(s.vel_mm_s[k]) / cfg.limits.vel_mm_s[k]);
+                if (cfg.limits.jerk_mm_s3[k] > 0)
+                    rep.worst_jerk_ratio =
+                        std::max(rep.worst_jerk_ratio,
+                                 std::fabs(s.jerk_mm_s3[k]) / cfg.limits.jerk_mm_s3[k]);
+            }
+        }
     }
-    EXPECT_NEAR(best, tol, 1e-6);
+    return rep;
+}
+
+// Corners with arcs: line -> arc (entering the circle at 90 degrees to its tangent), arc -> arc
+// (two circles meeting at 45 degrees), arc -> line (leaving at 60 degrees), and a helix -> line
+// corner; each blended within the tolerance instead of stopped, with or without a jerk limit.
+// (A Bezier blend's ends are curvature steps: under a jerk limit it is used only where they
+// can be passed at a good part of the feed, which 1e9 mm/s^3 allows here; lower limits stop.)
+class ArcCorners : public ::testing::TestWithParam<double> {};
+
+TEST_P(ArcCorners, AreBlendedWithinToleranceAndLimits) {
+    const double tol = 0.02;
+    PlannerConfig cfg = uniform(100, 1000, GetParam());
+    test::Program prog;
+    prog.start = {0, 0, 0};
+    const double r = 5;
+    // 0: line along +X to (5, 0). 1: clockwise half-way round (10, 0), starting along +Y
+    // (a 90 degree line -> arc corner) and ending at (10, 5) along +X.
+    prog.segs.push_back(line_to({5, 0}, 40, tol, 0));
+    prog.segs.push_back(arc_to({10, 5}, {10, 0}, -1, 40, tol, 1));
+    // 2: counter-clockwise about (10 + c, 5 + c), starting along (1, -1) / sqrt 2 (a 45 degree
+    // arc -> arc corner) and ending along +Y.
+    const double c = r / std::sqrt(2.0);
+    prog.segs.push_back(arc_to({10 + c + r, 5 + c}, {10 + c, 5 + c}, 1, 40, tol, 2));
+    // 3: a line at 120 degrees (a 30 degree arc -> line corner).
+    const double dir = 2 * std::numbers::pi / 3;
+    AxisArray p3 = prog.segs[2].end_mm;
+    prog.segs.push_back(
+        line_to({p3[0] + 10 * std::cos(dir), p3[1] + 10 * std::sin(dir)}, 40, tol, 3));
+    // 4: a clockwise helix half-way round a centre 5 mm along +X, rising 3 mm in Z (a 30 degree
+    // line -> helix corner); 5: a line along -Y (an 11 degree helix -> line corner).
+    AxisArray p4 = prog.segs[3].end_mm;
+    PathSegment helix = arc_to({p4[0] + 10, p4[1], 3}, {p4[0] + 5, p4[1]}, -1, 40, tol, 4);
+    prog.segs.push_back(helix);
+    AxisArray p5 = helix.end_mm;
+    prog.segs.push_back(line_to({p5[0], p5[1] - 5, 3}, 40, tol, 5));
+    auto recs = plan(cfg, prog.segs, prog.start);
+    CornerReport rep = check_corners(cfg, prog, recs);
+    EXPECT_EQ(rep.stops, 0);
+    EXPECT_GE(rep.beziers, 5);
+    EXPECT_LE(rep.worst_dev_mm, tol * (1 + 1e-9));
+    EXPECT_LE(rep.worst_acc_ratio, 1 + 1e-9);
+    EXPECT_LE(rep.worst_vel_ratio, 1 + 1e-9);
+    EXPECT_LE(rep.worst_jerk_ratio, 1 + 1e-9);
+}
+
+INSTANTIATE_TEST_SUITE_P(Jerk, ArcCorners, ::testing::Values(0.0, 1e9));
+
+// A run of small tangent arcs (alternating semicircles, end points rounded to 4 decimals as a
+// CAM program writes them) flows at the feed: the time is the length at feed plus one ramp up
+// and one down.
+TEST(Planner, SmallTangentArcsFlowAtFeed) {
+    PlannerConfig cfg = uniform(100, 1000, 0);
+    test::Program prog;
+    const double r = 1.2345, feed = 20;  // v^2 / r = 324 mm/s^2: within the centripetal share
+    std::vector<PathSegment>& segs = prog.segs;
+    double x = 0;
+    for (int i = 0; i < 200; ++i) {
+        double end = std::round((x + 2 * r) * 1e4) / 1e4;
+        segs.push_back(arc_to({end, 0}, {x + r, 0}, i % 2 ? 1 : -1, feed, 0.01, i));
+        x = end;
+    }
+    auto recs = plan(cfg, segs, prog.start);
+    double length = 200 * std::numbers::pi * r;
+    // Speeding up and slowing down at a tangential acceleration of at least half the usable
+    // 900 mm/s^2 (the centripetal part takes some of it on arcs) loses feed / a at most.
+    double ramp_s = feed / 450;
+    EXPECT_LE(total_time(recs), length / feed + ramp_s);
+    CornerReport rep = check_corners(cfg, prog, recs, 20);
+    EXPECT_EQ(rep.stops, 0);
+    EXPECT_LE(rep.worst_dev_mm, 0.01 * (1 + 1e-9));
+    EXPECT_LE(rep.worst_acc_ratio, 1 + 1e-9);
 }
 
 TEST(Planner, ArcSpeedRespectsCentripetalAcceleration) {

@@ -13,6 +13,12 @@
 //                    \  v
 // Curvature is zero at both ends, so a blend joins its lines without an acceleration step, and
 // the largest distance from the programmed corner lines is (3/16) l sin(angle).
+//
+// Bezier blend: a cubic Bezier curve B(u), u = s / length, from control points P0 (origin), P1
+// (a), P2 (b), P3 (end). length is the largest norm of the hodograph's control points
+// 3 (P[i+1] - P[i]), so |p'(s)| <= 1 as for the other elements. Used where the corner need not
+// join without an acceleration step (no jerk limit: the time-optimal parabolic corner, which is
+// a cubic with P1 = P0 + 2/3 (C - P0), P2 = P3 + 2/3 (C - P3)), and for corners with arcs.
 #pragma once
 
 #include <cstdint>
@@ -21,15 +27,16 @@
 
 namespace motion {
 
-enum class ElementKind : std::uint8_t { Line, Arc, Blend };
+enum class ElementKind : std::uint8_t { Line, Arc, Blend, Bezier };
 
 // Trivially copyable: it travels inside PreparedSegment through the realtime ring.
 struct Element {
     ElementKind kind = ElementKind::Line;
     double length_mm = 0;
     AxisArray origin{};  // line: start; arc: centre with the start's off-plane values; blend: start
-    AxisArray a{};       // line: unit direction; arc: in-plane unit u; blend: T1
-    AxisArray b{};       // arc: in-plane unit w (u x w = normal); blend: T2 - T1
+                         // bezier: P0
+    AxisArray a{};       // line: unit direction; arc: in-plane unit u; blend: T1; bezier: P1
+    AxisArray b{};       // arc: in-plane unit w (u x w = normal); blend: T2 - T1; bezier: P2
     AxisArray c{};       // arc: linear displacement of the off-plane axes over the whole arc
     AxisArray end{};     // exact programmed end, returned at s = length
     double radius_mm = 0;
@@ -67,6 +74,21 @@ struct EndDerivs {
 };
 EndDerivs start_derivs(const Element& e) noexcept;
 EndDerivs end_derivs(const Element& e) noexcept;
+
+// Cubic Bezier blend through control points p0..p3 (see above). Its pseudo length is positive
+// unless all four points coincide.
+Element make_bezier(const AxisArray& p0, const AxisArray& p1, const AxisArray& p2,
+                    const AxisArray& p3) noexcept;
+
+// The parabolic corner between two lines: from `l` before the corner (unit tangent t1) to `l`
+// after it (t2), control points 2/3 of the way to the corner. p'' = (t2 - t1) / 2l throughout,
+// and its largest distance from the lines is (l / 4) sin(angle).
+Element make_parabola(const AxisArray& corner, const AxisArray& t1, const AxisArray& t2,
+                      double l_mm) noexcept;
+
+// The arc element trimmed to [from_mm, length - to_mm] of the original (same circle, helix
+// pitch and direction).
+Element trim_arc(const Element& arc, double from_mm, double to_mm) noexcept;
 
 // The line element trimmed to [from_mm, length - to_mm] of the original.
 Element trim_line(const Element& line, double from_mm, double to_mm) noexcept;

@@ -21,6 +21,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -87,13 +88,25 @@ class Planner {
         double end_cap_mm_s;
         TangentLimits tangent;
     };
+    enum class Blend : std::uint8_t { None, Quartic, Parabola, Curve };
     struct Junction {
-        double cap_mm_s;
-        bool rough;
+        double cap_mm_s;    // speed limit where the first piece ends (at the blend if any)
+        bool rough;         // that junction is not smooth
         double blend_l_mm;  // > 0: insert a blend cutting this much from both sides
+        Blend blend = Blend::None;
+        Element curve{};                // the Bezier blend, for Blend::Curve
+        double curve_end_cap_mm_s = 0;  // speed limit where the Bezier blend ends
+        bool curve_end_rough = false;   // that junction is not smooth
     };
 
     Junction classify(const Piece& p, const Piece& next) const;
+    // A Bezier blend for a corner with an arc (or any corner without a jerk limit), or none
+    // (blend_l_mm = 0) when no blend within the tolerance fits.
+    Junction bezier_corner(const Piece& p, const Piece& next, double sin_angle,
+                           double feed_mm_s) const;
+    // Highest speed at which a step between these second derivatives stays within the
+    // junction share of one period's jerk (infinite without a jerk limit).
+    double curvature_step_cap(const AxisArray& d2_before, const AxisArray& d2_after) const;
     void close_piece(Piece& p, Piece* next);
     void add_item(const Element& e, double feed, double end_cap, bool rough, std::int32_t line);
     std::size_t plan_and_emit(bool all);  // returns how many records it emitted
