@@ -11,6 +11,7 @@
 #include <variant>
 
 #include "interp/canon.hpp"
+#include "interp/canon_wire.hpp"
 #include "interp/dialect.hpp"
 #include "interp/executor.hpp"
 #include "interp/interpreter.hpp"
@@ -26,7 +27,7 @@ ProgramFeeder::~ProgramFeeder() {
 }
 
 bool ProgramFeeder::start_and_wait_ready() {
-    if (thread_.joinable() || idle()) return false;
+    if (thread_.joinable() || idle_.load(std::memory_order_acquire)) return false;
     pause_.store(false, std::memory_order_relaxed);
     {
         std::lock_guard lock(mutex_);
@@ -43,9 +44,28 @@ void ProgramFeeder::stop() {
     if (thread_.joinable()) thread_.join();
 }
 
+bool ProgramFeeder::idle() const noexcept {
+    seen_barrier_state_ = barrier_state_.load(std::memory_order_acquire);
+    return idle_.load(std::memory_order_acquire) || (seen_barrier_state_ & 1) != 0;
+}
+
+std::uint32_t ProgramFeeder::acknowledge(bool in_position) noexcept {
+    // In position with the feeder idle: every record up to the barrier it stood at when idle()
+    // looked has been followed to the end.
+    if (in_position) acknowledged_ = static_cast<std::uint32_t>(seen_barrier_state_ >> 1);
+    return acknowledged_;
+}
+
 void ProgramFeeder::wait_for_lead() const noexcept {
-    while (!idle() && !abandoned_.load(std::memory_order_relaxed) && ring_.free_slots() > 0)
+    // Also returns at a barrier motion has not reached yet (it must run there first); at one it
+    // has acknowledged, it waits for the interpreter to go on, so the first period after a
+    // queue-busting read is the same on every run.
+    while (!idle_.load(std::memory_order_acquire) && !abandoned_.load(std::memory_order_relaxed) &&
+           ring_.free_slots() > 0) {
+        const std::uint64_t b = barrier_state_.load(std::memory_order_acquire);
+        if ((b & 1) && acknowledged_ < (b >> 1)) return;
         std::this_thread::yield();
+    }
 }
 
 std::string ProgramFeeder::error() const {
@@ -90,12 +110,14 @@ void ProgramFeeder::fail(const std::string& message) {
 void ProgramFeeder::open_program() {
     planner_ = std::make_unique<motion::Planner>(cfg_.plan, motion::AxisArray{});
     sink_ = make_plan_sink(*planner_, cfg_, *this);
+    if (cfg_.canon_source) {
+        decoder_ = std::make_unique<interp::wire::Decoder>();
+        return;
+    }
     interp::InterpreterOptions options;
     options.main_m99_loops = false;  // a looping program would plan forever
     if (!cfg_.dialect.empty()) options.dialect = interp::find_dialect(cfg_.dialect);
-    interp::BackendConfig backend;
-    backend.optional_stop = true;  // M01 reaches motion, which obeys motion.optional-stop
-    executor_ = std::make_unique<interp::Executor>(*sink_, backend);
+    executor_ = std::make_unique<interp::Executor>(*sink_, interp::BackendConfig{});
     interpreter_ = std::make_unique<interp::Interpreter>(*executor_, *executor_, options);
     interpreter_->open(cfg_.program_path);
 }
@@ -116,16 +138,24 @@ void ProgramFeeder::run() noexcept {
     while (!stopping()) {
         deliver();
         if (ring_.free_slots() == 0) mark_ready();  // a full lead: start() may return
+        reach_barrier_if_delivered();
         if (program_done_ && outbox_.empty()) break;
-        if (program_done_ || outbox_.size() >= kOutboxLimit) {
+        if (program_done_ || outbox_.size() >= kOutboxLimit || barrier_pending_) {
             std::this_thread::sleep_for(std::chrono::microseconds(200));
             continue;
         }
         try {
-            if (!interpreter_->step()) {
-                planner_->finish();
-                collect();
-                program_done_ = true;
+            switch (step()) {
+                case Progress::End:
+                    planner_->finish();
+                    collect();
+                    program_done_ = true;
+                    break;
+                case Progress::Starved:  // the interp component has not sent more yet
+                    std::this_thread::sleep_for(std::chrono::microseconds(50));
+                    break;
+                case Progress::More:
+                    break;
             }
         } catch (const std::exception& e) {
             fail(e.what());
@@ -134,6 +164,51 @@ void ProgramFeeder::run() noexcept {
     if ((program_done_ && outbox_.empty()) || abandoned_.load(std::memory_order_relaxed))
         idle_.store(true, std::memory_order_release);
     mark_ready();
+}
+
+ProgramFeeder::Progress ProgramFeeder::step() {
+    if (cfg_.canon_source) return read_stream();
+    return interpreter_->step() ? Progress::More : Progress::End;
+}
+
+// One command from the stream per call, as the in-process interpreter gives one line per step.
+ProgramFeeder::Progress ProgramFeeder::read_stream() {
+    interp::wire::Record r;
+    while (cfg_.canon_source(r)) {
+        leave_barrier();
+        switch (decoder_->feed(r)) {
+            case interp::wire::Decoder::Item::None:
+                continue;
+            case interp::wire::Decoder::Item::End:
+                if (decoder_->failed()) throw std::runtime_error(decoder_->error());
+                return Progress::End;
+            case interp::wire::Decoder::Item::Command: {
+                const interp::Canon& c = decoder_->command();
+                sink_->emit(c);
+                if (std::holds_alternative<interp::canon::Sync>(c.cmd)) {
+                    // Whatever the sink made of it, the machine must come to rest here.
+                    planner_->finish();
+                    collect();
+                    barrier_pending_ = true;
+                }
+                return Progress::More;
+            }
+        }
+    }
+    return Progress::Starved;
+}
+
+void ProgramFeeder::reach_barrier_if_delivered() {
+    if (!barrier_pending_ || !outbox_.empty()) return;
+    barrier_pending_ = false;
+    ++barriers_;
+    barrier_state_.store(std::uint64_t{barriers_} << 1 | 1, std::memory_order_release);
+    mark_ready();  // start() may return: the machine has to move before anything more comes
+}
+
+void ProgramFeeder::leave_barrier() noexcept {
+    if (barrier_state_.load(std::memory_order_relaxed) & 1)
+        barrier_state_.store(std::uint64_t{barriers_} << 1, std::memory_order_release);
 }
 
 }  // namespace motioncomp

@@ -1,6 +1,14 @@
-// The non-realtime side of the motion component: a thread that runs the interpreter on a
-// program file, turns its canonical commands into planner segments and keeps the realtime
-// ring filled with prepared records. HAL-free; motion.cpp owns it.
+// The non-realtime side of the motion component: a thread that gets canonical commands (from
+// the interpreter run on a program file in-process, or decoded from the `interp` component's
+// stream), turns them into planner segments and keeps the realtime ring filled with prepared
+// records. HAL-free; motion.cpp owns it.
+//
+// Barriers (canon::Sync, sent by the interp component for G906 and for queue-busting reads
+// such as #CURMACHPOS): the feeder finishes the planner, delivers everything before the barrier
+// into the ring and then stands "at the barrier" (idle) until the next record arrives. Once the
+// servo side is in position there, acknowledge() returns the barrier's number, which motion
+// publishes (motion.canon-sync) and the interp component waits for before it reads the
+// machine's position.
 #pragma once
 
 #include <array>
@@ -8,15 +16,16 @@
 #include <condition_variable>
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
 #include <thread>
 
+#include "interp/canon_wire.hpp"
 #include "motion/planner.hpp"
 #include "motion/prepared.hpp"
 #include "motion/spsc_ring.hpp"
-#include "plan_sink.hpp"
 
 namespace interp {
 class Executor;
@@ -27,13 +36,15 @@ class CanonSink;
 namespace motioncomp {
 
 struct FeederConfig {
-    std::string program_path;
+    std::string program_path;  // run in-process when canon_source is empty
+    // Pops the next record of the canonical stream (interp/canon_wire.hpp) into the argument;
+    // false when none is waiting. Set: commands come from the stream, not from program_path.
+    std::function<bool(interp::wire::Record&)> canon_source;
     std::string dialect;  // empty: the interpreter's default (ncstudio)
     motion::PlannerConfig plan;
     std::array<bool, motion::kAxes> axis_present{};  // axes named by coordinates=
     std::string coordinates;                         // for error messages
     double blend_tolerance_mm = 0;
-    SinkConfig machine;  // soft limits and I/O counts the sink checks moves and commands against
 };
 
 class ProgramFeeder {
@@ -59,8 +70,12 @@ class ProgramFeeder {
     // opt-in lock-step mode of simulated-clock runs (see docs/components/motion.md).
     void wait_for_lead() const noexcept;
 
-    // Realtime-safe status.
-    bool idle() const noexcept { return idle_.load(std::memory_order_acquire); }
+    // Realtime-safe status. idle(): nothing more is being planned now (the program is over, or
+    // the feeder stands at a barrier); servo thread only, as it remembers which barrier it saw.
+    bool idle() const noexcept;
+    // Servo thread, once per period after idle(): `in_position` is motion's verdict for this
+    // period. Returns the number of barriers the machine has reached in position.
+    std::uint32_t acknowledge(bool in_position) noexcept;
     bool failed() const noexcept { return failed_.load(std::memory_order_acquire); }
     std::uint32_t ignored_commands() const noexcept {
         return ignored_.load(std::memory_order_relaxed);
@@ -74,8 +89,13 @@ class ProgramFeeder {
     void collect(const motion::PreparedSegment* extra = nullptr);
 
   private:
+    enum class Progress { More, Starved, End };
     void run() noexcept;
     void open_program();
+    Progress step();
+    Progress read_stream();
+    void reach_barrier_if_delivered();
+    void leave_barrier() noexcept;
     bool stopping() const noexcept;
     void deliver() noexcept;  // outbox -> ring, as far as it fits
     void fail(const std::string& message);
@@ -89,6 +109,7 @@ class ProgramFeeder {
     std::unique_ptr<interp::CanonSink> sink_;
     std::unique_ptr<interp::Executor> executor_;
     std::unique_ptr<interp::Interpreter> interpreter_;
+    std::unique_ptr<interp::wire::Decoder> decoder_;  // stream mode
     std::deque<motion::PreparedSegment> outbox_;  // planned, in order, not yet in the ring
     bool program_done_ = false;                   // interpreter ended (or failed), planner finished
 
@@ -98,6 +119,15 @@ class ProgramFeeder {
     std::atomic<bool> idle_{false};
     std::atomic<bool> failed_{false};
     std::atomic<std::uint32_t> ignored_{0};
+
+    // Barriers: count << 1 | (1 while standing at the latest one). Written by the feeder thread;
+    // the servo thread reads it once per period in idle() and keeps what it saw for
+    // acknowledge(), so the two agree within a period.
+    bool barrier_pending_ = false;  // a Sync decoded, records before it not yet all delivered
+    std::uint32_t barriers_ = 0;
+    std::atomic<std::uint64_t> barrier_state_{0};
+    mutable std::uint64_t seen_barrier_state_ = 0;  // servo thread only
+    std::uint32_t acknowledged_ = 0;                // servo thread only
 
     mutable std::mutex mutex_;
     std::condition_variable ready_cv_;

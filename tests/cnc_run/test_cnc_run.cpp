@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -234,9 +235,19 @@ TEST_F(PocketRun, PlainProgressLinesOncePerSecond) {
     EXPECT_EQ(result_->out.find('\r'), std::string::npos);
 }
 
-TEST_F(PocketRun, PreviewIsWritten) {
-    // What the picture shows is checked in tests/cnc_preview (the PNG read back by panel).
-    EXPECT_NE(svg_->find("<svg "), std::string::npos) << "not an SVG";
+TEST_F(PocketRun, PreviewDrawsThreeViewsWithRapidsAndFeeds) {
+    ASSERT_EQ(svg_->rfind("<svg ", 0), 0u) << "not an SVG";
+    for (const char* label : {">XY (top)<", ">XZ (front)<", ">YZ (side)<"})
+        EXPECT_NE(svg_->find(label), std::string::npos) << label;
+    EXPECT_NE(svg_->find("<polyline class=\"feed\""), std::string::npos);
+    // The first move is the rapid from the machine origin, which is the low corner of the
+    // path's X and Y extents (0..60, 0..50): in the XY view (left edge 16 px, 12 px padding,
+    // bottom edge 40 + 300 px) that is (16 + 12, 340 - 12).
+    const auto first = svg_->find("<polyline ");
+    ASSERT_NE(first, std::string::npos);
+    const std::string rapid = "<polyline class=\"rapid\"";
+    EXPECT_EQ(svg_->compare(first, rapid.size(), rapid), 0);
+    EXPECT_NE(svg_->find("points=\"28.00,328.00 ", first), std::string::npos);
     EXPECT_NE(result_->out.find("\npreview: "), std::string::npos);
 }
 
@@ -541,6 +552,77 @@ TEST(CncRunErrors, ConfigWithoutMotionIsRefused) {
     EXPECT_EQ(r.err, ini.string() +
                          ": the HAL files do not load the motion component (no pin "
                          "motion.in-position)\n");
+}
+
+}  // namespace
+
+namespace {
+
+// The sim configs run the program through the interp component and its stream. A read of the
+// machine's position (#CURMACHPOS.X) and G906 make the interpreter wait for motion: the
+// machine stops there in position, which is not yet the end of the program.
+TEST(CncRunInterp, QueueBustingReadsWaitForTheMachineAndRunTheSameEveryTime) {
+    ScratchDir scratch;
+    const fs::path prog = scratch.path() / "read.ngc";
+    std::ofstream(prog) << "G90 G21\nG01 X10 F600\n#1 = #CURMACHPOS.X\nG01 Y=#1\nG906\n"
+                           "G01 X0 Y0\nM30\n";
+    std::string outs[2], traces[2];
+    for (int i = 0; i < 2; ++i) {
+        const fs::path csv = scratch.path() / fmt::format("t{}.csv", i);
+        const RunResult r = run_cnc(fmt::format("configs/sim/mill.ini '{}' --sim-clock --trace '{}'",
+                                                prog.string(), csv.string()),
+                                    scratch.path());
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        outs[i] = r.out;
+        traces[i] = slurp(csv);
+    }
+    EXPECT_EQ(outs[0], outs[1]);
+    EXPECT_TRUE(traces[0] == traces[1]) << "traces differ";
+    // Not ended at the stop where the read waits (X10 Y0): the last move returns to X0 Y0.
+    EXPECT_NE(outs[0].find("\nfinal position (mm): x 0.0000  y 0.0000  z 0.0000\n"),
+              std::string::npos)
+        << outs[0];
+    // The Y move of line 4 goes to the X position read on line 3: the path reaches Y10 and
+    // stands still there (G906) before the diagonal home.
+    std::string header;
+    const auto rows = csv_rows(traces[0], header);
+    double max_y = 0;
+    for (const auto& row : rows) max_y = std::max(max_y, row[3]);
+    EXPECT_NEAR(max_y, 10.0, 1e-9);
+    // 10 + 10 + 14.14 mm at 10 mm/s with stops between: a little over 3.4 s.
+    const double t = summary_number(outs[0], "motion time");
+    EXPECT_GT(t, 3.41);
+    EXPECT_LT(t, 4.0);
+}
+
+TEST(CncRunInterp, InterpreterErrorAfterAReadStopsTheMachineAndNamesFileLineCol) {
+    // The error on line 4 is found only after the read on line 3 has waited for the X move:
+    // the machine ends at X10, the run fails with the interpreter's file:line:col ('Q' is
+    // column 9 of "G01 X20 Q").
+    ScratchDir scratch;
+    const fs::path prog = scratch.path() / "late.ngc";
+    std::ofstream(prog) << "G90 G21\nG01 X10 F600\n#1 = #CURMACHPOS.X\nG01 X20 Q\nM30\n";
+    const RunResult r = run_cnc(fmt::format("configs/sim/mill.ini '{}' --sim-clock", prog.string()),
+                                scratch.path());
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find(prog.string() + ":4:9: expected a number or '=' after Q"),
+              std::string::npos)
+        << r.err;
+    EXPECT_NE(r.out.find("\nresult: error\n"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("\nfinal position (mm): x 10.0000  y 0.0000  z 0.0000\n"),
+              std::string::npos)
+        << r.out;
+}
+
+TEST(CncRunInterp, SyntaxErrorNamesColumnAndNothingMoves) {
+    ScratchDir scratch;
+    const fs::path bad = scratch.path() / "bad.ngc";
+    std::ofstream(bad) << "G90 G21\nG01 X10 F600\nG01 X20 Q\nM30\n";  // 'Q': column 9
+    const RunResult r =
+        run_cnc(fmt::format("configs/sim/mill.ini '{}' --sim-clock", bad.string()), scratch.path());
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.err, bad.string() + ":3:9: expected a number or '=' after Q\n");
+    EXPECT_EQ(r.out.find("final position"), std::string::npos) << "nothing may run";
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 // `cnc run`: the product's main job. Loads an INI, runs its [HAL]HALFILEs in a HAL instance
-// owned by this process, names the program to the motion component (environment variable
-// CNC_PROGRAM, which the config's `loadrt motion program=$(CNC_PROGRAM)` reads), starts the
-// threads and watches motion's pins until the program ends, a fault, a timeout or Ctrl-C.
+// owned by this process, names the program to the config (environment variable CNC_PROGRAM,
+// which the config's `loadrt interp program=$(CNC_PROGRAM)` reads; the interp component
+// streams its canonical commands to motion), starts the threads and watches motion's pins
+// until the program ends (interp.done and motion.in-position), a fault, a timeout or Ctrl-C.
 //
 // Two clocks: the real one (the HAL threads run on their own; a sampler stream hands this loop
 // every cycle's pins) and --sim-clock (this loop advances the simulated clock one servo period
@@ -193,6 +194,9 @@ struct MachinePins {
     Probe in_position, fault, enable, line, vel;
     std::string letters;  // axes that have axis.L.pos-cmd
     std::vector<Probe> axis_cmd, ferror, ferror_limit, ferrored, amp_fault, joint_fb;
+    // interp.done when the config loads the interp component: motion in position is the end
+    // only once the interpreter has sent everything (it also stops at queue-busting reads).
+    std::optional<Probe> interp_done;
 };
 
 MachinePins find_pins(hal::Runtime& rt, const std::string& ini, const std::string& letters) {
@@ -210,7 +214,8 @@ MachinePins find_pins(hal::Runtime& rt, const std::string& ini, const std::strin
                   {},
                   {},
                   {},
-                  {}};
+                  {},
+                  try_probe(rt, "interp.done")};
     for (char l : letters) {
         if (auto probe = try_probe(rt, fmt::format("axis.{}.pos-cmd", l))) {
             p.letters += l;
@@ -235,6 +240,7 @@ struct Sample {
     std::vector<double> axis_mm, joint_fb_mm, ferror_mm;
     double vel_mm_s = 0;
     bool in_position = false, fault = false, enabled = false;
+    bool program_done = true;  // interp.done (true without the interp component)
 };
 
 void read_sample(const MachinePins& p, double t_s, Sample& s) {
@@ -252,6 +258,7 @@ void read_sample(const MachinePins& p, double t_s, Sample& s) {
     s.in_position = p.in_position.bit();
     s.fault = p.fault.bit();
     s.enabled = p.enable.bit();
+    s.program_done = !p.interp_done || p.interp_done->bit();
 }
 
 // Running figures for the summary. Velocities and accelerations are differences of
@@ -512,7 +519,7 @@ LoopResult watch(Session& session, const MachinePins& pins, const RunOptions& o,
             r.outcome = Outcome::NeverEnabled;
             return r;
         }
-        if (s.in_position) return r;
+        if (s.in_position && s.program_done) return r;
         if (s.t_s >= o.timeout_s) {
             r.outcome = Outcome::Timeout;
             return r;
@@ -543,6 +550,12 @@ class CycleStream {
         cfg += std::string(names.size() - 1, 'f');
         for (const char* bit : {"motion.in-position", "motion.fault", "motion.enable"}) {
             names.push_back(bit);
+            cfg += 'b';
+        }
+        // interp.done rides along when there is room (5 axes and 5 joints fill the record);
+        // otherwise the loop reads it live (see done_after).
+        if (p.interp_done && names.size() < hal::kMaxStreamFields) {
+            names.push_back("interp.done");
             cfg += 'b';
         }
         const std::string thread = servo_thread(s);
@@ -583,6 +596,7 @@ class CycleStream {
         s.in_position = record_[f++].b;
         s.fault = record_[f++].b;
         s.enabled = record_[f++].b;
+        s.program_done = has_done_ ? record_[f++].b : done_after(cycles_);
     }
 
     // Cycles lost because the loop fell more than the stream's depth behind.
@@ -599,7 +613,25 @@ class CycleStream {
           period_s_(period_s),
           axes_(p.letters.size()),
           joints_(p.ferror.size()),
+          has_done_(p.interp_done.has_value() && ring->fields > f_without_done(p)),
+          done_probe_(p.interp_done ? &*p.interp_done : nullptr),
           record_(ring->fields) {}
+
+    // interp.done read live for a record that does not carry it: true only for cycles sampled
+    // after the loop first saw it TRUE (a stop at a queue-busting read just before the end
+    // must not pass for the end). May end a run a few cycles late, never early.
+    bool done_after(long cycle) {
+        if (!done_probe_) return true;
+        if (done_from_cycle_ < 0 && done_probe_->bit())
+            done_from_cycle_ = cycles_ + static_cast<long>(ring_->used());
+        return done_from_cycle_ >= 0 && cycle > done_from_cycle_;
+    }
+
+    // Fields of a record without interp.done: line, axes, joint feedback, f-errors, velocity
+    // and the three motion bits.
+    static std::size_t f_without_done(const MachinePins& p) {
+        return 1 + p.letters.size() + 2 * p.ferror.size() + 1 + 3;
+    }
 
     // The thread motion-controller runs in: servo-thread by LinuxCNC's convention, or the
     // only thread there is.
@@ -627,6 +659,9 @@ class CycleStream {
     hal::Ring* ring_;
     double period_s_;
     std::size_t axes_, joints_;
+    bool has_done_;
+    const Probe* done_probe_;  // read live when interp.done is not in the record
+    long done_from_cycle_ = -1;
     std::vector<hal::Value> record_;
     long cycles_ = 0;
 };
@@ -743,7 +778,8 @@ int run_session(const RunOptions& o, const Config& c, Session& session, const St
     print_summary(o, c, pins, r, stats, error);
     if (preview) {
         try {
-            preview->write(o.preview_path, PreviewCaption{o.program, o.ini, r.last.t_s});
+            preview->write_svg(o.preview_path,
+                               fmt::format("{} on {}: {:.3f} s", o.program, o.ini, r.last.t_s));
         } catch (const std::runtime_error& e) {
             fmt::print(stderr, "{}\n", e.what());
             return 1;
@@ -770,9 +806,14 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& o) {
     cmd->add_option("--trace", o.trace_path,
                     "CSV of t,line,axes,joints,vel, one row per servo cycle");
     cmd->add_option("--preview", o.preview_path,
-                    "PNG or SVG picture of the path followed (top, front, side and isometric "
-                    "views; feeds and rapids)")
-        ->check(CLI::Validator(preview_path_error, "FILE.png|FILE.svg"));
+                    "SVG picture of the path followed (XY, XZ, YZ views; feeds and rapids)")
+        ->check(CLI::Validator(
+            [](std::string& path) {
+                return path.size() > 4 && path.compare(path.size() - 4, 4, ".svg") == 0
+                           ? std::string{}
+                           : "--preview writes SVG: the file name must end in .svg";
+            },
+            "FILE.svg"));
     cmd->add_option("--timeout", o.timeout_s, "give up after this much motion time, s")
         ->check(CLI::PositiveNumber);
     return cmd;

@@ -30,6 +30,9 @@ namespace interp::wire {
 
 inline constexpr std::size_t kWireFields = 20;
 using Record = std::array<std::uint64_t, kWireFields>;
+// The layout of a HAL stream carrying records: one u64 field (cfg letter k) per word.
+inline constexpr char kStreamLayout[] = "kkkkkkkkkkkkkkkkkkkk";
+static_assert(sizeof(kStreamLayout) - 1 == kWireFields);
 
 // A record sequence that does not decode (a bug or a foreign producer): what and where.
 class Error : public std::runtime_error {

@@ -1,0 +1,131 @@
+// interp: runs a G-code program through the interpreter library in a non-realtime thread and
+// writes the canonical commands into a HAL stream (interp/canon_wire.hpp records), which the
+// motion component reads (`loadrt motion canon=interp.canon`). Queue-busting reads
+// (#CURMACHPOS, #CURWORKPOS, G906) wait until motion has followed everything sent and stands
+// in position (motion.canon-sync, wired to interp.motion-sync), then read the machine's
+// position from interp.machine-pos-L. See docs/components/interp.md.
+#include <fmt/format.h>
+
+#include <array>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include "hal/component.hpp"
+#include "interp/canon_wire.hpp"
+#include "interp/dialect.hpp"
+#include "program_runner.hpp"
+
+namespace {
+
+constexpr long kDefaultDepth = 1024;
+
+class Interp : public hal::Instance, public interpcomp::MachineLink {
+  public:
+    // The default instance publishes fixed names (interp.program-line, stream interp.canon);
+    // one given a name with names=a prefixes them with it (a.program-line, a.canon).
+    std::string pin(std::string_view n) const {
+        return default_named() ? "=interp." + std::string(n) : std::string(n);
+    }
+
+    Interp()
+        : stream_(this, stream_name(), interp::wire::kStreamLayout, stream_depth()),
+          runner_(runner_config(), *this) {}
+
+    void start() override {
+        if (runner_.start_and_wait_ready()) throw hal::Error(runner_.error());
+        on_progress();
+    }
+
+    void stop() override {
+        runner_.stop();
+        report_error();
+    }
+
+    ~Interp() override {
+        runner_.stop();
+        report_error();
+    }
+
+    // MachineLink, called on the runner's thread.
+    bool push(const interp::wire::Record& r) noexcept override {
+        hal::Value v[interp::wire::kWireFields];
+        for (std::size_t i = 0; i < r.size(); ++i) v[i].u64 = r[i];
+        return stream_.push(v);
+    }
+    std::uint32_t barriers_reached() const noexcept override { return motion_sync_.get(); }
+    double machine_pos_mm(int axis) const noexcept override { return machine_pos_[axis]->get(); }
+    bool abort_requested() const noexcept override { return abort_.get(); }
+    void on_progress() noexcept override {
+        program_line_ = runner_.line();
+        running_ = runner_.running();
+        waiting_ = runner_.waiting();
+        done_ = runner_.done();
+        error_ = runner_.failed();
+    }
+
+  private:
+    bool default_named() const { return name() == fmt::format("interp.{}", index()); }
+
+    // interp.machine-pos-x … -c: the interpreter's machine axes X Y Z A B C.
+    std::array<std::unique_ptr<hal::In<double>>, interp::kMachineAxes> make_machine_pos() {
+        std::array<std::unique_ptr<hal::In<double>>, interp::kMachineAxes> pins;
+        for (int a = 0; a < interp::kMachineAxes; ++a)
+            pins[a] = std::make_unique<hal::In<double>>(
+                this, pin(fmt::format("machine-pos-{}", "xyzabc"[a])));
+        return pins;
+    }
+
+    std::string stream_name() const {
+        if (auto s = arg("stream")) return *s;
+        return default_named() ? "interp.canon" : fmt::format("{}.canon", name());
+    }
+
+    std::uint32_t stream_depth() const {
+        const long n = arg_int("depth", kDefaultDepth);
+        if (n < 2 || n > (1L << 20))
+            throw hal::Error(fmt::format("depth={}: must be 2 to {} records", n, 1L << 20));
+        return static_cast<std::uint32_t>(n);
+    }
+
+    interpcomp::RunnerConfig runner_config() const {
+        interpcomp::RunnerConfig cfg;
+        cfg.program_path = arg("program").value_or("");
+        if (cfg.program_path.empty())
+            throw hal::Error("program= is required: the G-code file to run");
+        if (!std::ifstream(cfg.program_path))
+            throw hal::Error(fmt::format("program={}: cannot open the file", cfg.program_path));
+        cfg.dialect = arg("dialect").value_or("");
+        if (!cfg.dialect.empty() && !interp::find_dialect(cfg.dialect))
+            throw hal::Error(fmt::format("dialect={}: unknown dialect", cfg.dialect));
+        cfg.standalone = arg_int("standalone", 0) != 0;
+        return cfg;
+    }
+
+    // An error met after `start` reaches the consumer in the stream's end record, and motion
+    // reports it; it is printed here only when nobody can have read it.
+    void report_error() {
+        if (reported_ || !runner_.failed()) return;
+        if (runner_.end_sent() && !arg_int("standalone", 0)) return;
+        reported_ = true;
+        fmt::print(stderr, "{}: {}\n", name(), runner_.error());
+    }
+
+    hal::Out<std::int32_t> program_line_{this, pin("program-line")};
+    hal::Out<bool> running_{this, pin("running")};
+    hal::Out<bool> waiting_{this, pin("waiting")};
+    hal::Out<bool> done_{this, pin("done")};
+    hal::Out<bool> error_{this, pin("error")};
+    hal::In<bool> abort_{this, pin("abort")};
+    hal::In<std::uint32_t> motion_sync_{this, pin("motion-sync")};
+    std::array<std::unique_ptr<hal::In<double>>, interp::kMachineAxes> machine_pos_ =
+        make_machine_pos();
+    hal::Stream stream_;
+    interpcomp::ProgramRunner runner_;
+    bool reported_ = false;
+};
+
+}  // namespace
+
+HAL_COMPONENT(interp, Interp, "G-code interpreter writing canonical commands into a HAL stream",
+              "program", "dialect", "stream", "depth", "standalone")

@@ -1,0 +1,219 @@
+#include "program_runner.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <exception>
+#include <utility>
+#include <variant>
+
+#include "interp/canon.hpp"
+#include "interp/dialect.hpp"
+#include "interp/executor.hpp"
+#include "interp/interpreter.hpp"
+
+namespace interpcomp {
+
+namespace {
+// Interpreting runs ahead of the stream by at most this many records: more would only cost
+// memory, as the consumer cannot take them before the stream has room.
+constexpr std::size_t kOutboxLimit = 256;
+constexpr auto kPollInterval = std::chrono::microseconds(100);
+}  // namespace
+
+// The executor's sink: commands go to the stream; a Sync (G906) is a barrier to wait at.
+class ProgramRunner::Sink final : public interp::CanonSink {
+  public:
+    explicit Sink(ProgramRunner& runner) : runner_(runner) {}
+    void emit(const interp::Canon& c) override {
+        if (std::holds_alternative<interp::canon::Sync>(c.cmd))
+            runner_.sync(c.loc);
+        else
+            runner_.send(c);
+    }
+
+  private:
+    ProgramRunner& runner_;
+};
+
+// What named parameters read. Positions are the machine's live ones after a barrier (motion
+// has followed everything sent and stands in position); modal state, settings, inputs and
+// outputs come from the executor's model.
+class ProgramRunner::LiveMachine final : public interp::MachineQuery {
+  public:
+    LiveMachine(ProgramRunner& runner, interp::Executor& exec) : runner_(runner), exec_(exec) {}
+
+    double machine_pos_mm(interp::Axis axis) override {
+        if (runner_.cfg_.standalone) return exec_.machine_pos_mm(axis);
+        if (!runner_.machine_current()) runner_.sync(runner_.last_loc_);
+        return runner_.link_.machine_pos_mm(static_cast<int>(axis));
+    }
+    // The work offsets are the interpreter's: work = machine - (model machine - model work).
+    double work_pos_mm(interp::Axis axis) override {
+        const double offset_mm = exec_.machine_pos_mm(axis) - exec_.work_pos_mm(axis);
+        return machine_pos_mm(axis) - offset_mm;
+    }
+    std::uint64_t input_bits() override { return exec_.input_bits(); }
+    std::uint64_t output_bits() override { return exec_.output_bits(); }
+    double spindle_rpm() override { return exec_.spindle_rpm(); }
+    double mm_per_program_unit() override { return exec_.mm_per_program_unit(); }
+    bool incremental_mode() override { return exec_.incremental_mode(); }
+    bool cycle_return_to_r() override { return exec_.cycle_return_to_r(); }
+    std::optional<double> setting(std::string_view name) override { return exec_.setting(name); }
+
+  private:
+    ProgramRunner& runner_;
+    interp::Executor& exec_;
+};
+
+ProgramRunner::ProgramRunner(RunnerConfig cfg, MachineLink& link)
+    : cfg_(std::move(cfg)), link_(link) {}
+
+ProgramRunner::~ProgramRunner() {
+    stop();
+}
+
+bool ProgramRunner::start_and_wait_ready() {
+    if (thread_.joinable() || done() || failed()) return failed();
+    pause_.store(false, std::memory_order_relaxed);
+    {
+        std::lock_guard lock(mutex_);
+        ready_ = false;
+    }
+    running_.store(true, std::memory_order_relaxed);
+    thread_ = std::thread([this] { run(); });
+    std::unique_lock lock(mutex_);
+    ready_cv_.wait(lock, [this] { return ready_; });
+    return failed_at_ready_;
+}
+
+void ProgramRunner::stop() {
+    pause_.store(true, std::memory_order_relaxed);
+    if (thread_.joinable()) thread_.join();
+    running_.store(false, std::memory_order_relaxed);
+}
+
+std::string ProgramRunner::error() const {
+    std::lock_guard lock(mutex_);
+    return error_;
+}
+
+std::string ProgramRunner::where() const {
+    if (last_loc_.line == 0) return cfg_.program_path;
+    return fmt::format("{}:{}:{}", last_loc_.file, last_loc_.line, last_loc_.col);
+}
+
+bool ProgramRunner::stopping() noexcept {
+    if (link_.abort_requested()) abort_.store(true, std::memory_order_relaxed);
+    return pause_.load(std::memory_order_relaxed) || abort_.load(std::memory_order_relaxed);
+}
+
+void ProgramRunner::mark_ready() {
+    std::lock_guard lock(mutex_);
+    if (ready_) return;
+    ready_ = true;
+    failed_at_ready_ = failed();
+    ready_cv_.notify_all();
+}
+
+void ProgramRunner::send(const interp::Canon& c) {
+    scratch_.clear();
+    encoder_.command(c, scratch_);
+    outbox_.insert(outbox_.end(), scratch_.begin(), scratch_.end());
+    last_loc_ = c.loc;
+    line_.store(c.loc.line, std::memory_order_relaxed);
+    current_ = false;
+}
+
+void ProgramRunner::sync(const interp::SourceLoc& loc) {
+    send(interp::Canon{loc, interp::canon::Sync{}});
+    if (cfg_.standalone) return;
+    const std::uint32_t target = barriers_.fetch_add(1, std::memory_order_relaxed) + 1;
+    waiting_.store(true, std::memory_order_relaxed);
+    while (!(deliver() && link_.barriers_reached() >= target)) {
+        if (stopping()) {
+            waiting_.store(false, std::memory_order_relaxed);
+            throw Stopped{};
+        }
+        mark_ready();  // start() returns: the machine must move before the program goes on
+        link_.on_progress();
+        std::this_thread::sleep_for(kPollInterval);
+    }
+    waiting_.store(false, std::memory_order_relaxed);
+    current_ = true;
+}
+
+bool ProgramRunner::deliver() noexcept {
+    while (!outbox_.empty() && link_.push(outbox_.front())) outbox_.pop_front();
+    return outbox_.empty();
+}
+
+// The end record goes last; done/failed are set before it can reach the consumer, so whoever
+// sees the machine stop after the program's end also sees why.
+void ProgramRunner::finish(const std::string& error) {
+    if (error.empty()) {
+        done_.store(true, std::memory_order_release);
+    } else {
+        {
+            std::lock_guard lock(mutex_);
+            error_ = error;
+        }
+        failed_.store(true, std::memory_order_release);
+    }
+    scratch_.clear();
+    encoder_.end(error, scratch_);
+    outbox_.insert(outbox_.end(), scratch_.begin(), scratch_.end());
+    finished_ = true;
+    running_.store(false, std::memory_order_relaxed);
+    link_.on_progress();
+}
+
+void ProgramRunner::open_program() {
+    sink_ = std::make_unique<Sink>(*this);
+    interp::InterpreterOptions options;
+    options.main_m99_loops = false;  // a looping program would run forever
+    if (!cfg_.dialect.empty()) options.dialect = interp::find_dialect(cfg_.dialect);
+    executor_ = std::make_unique<interp::Executor>(*sink_, interp::BackendConfig{});
+    machine_ = std::make_unique<LiveMachine>(*this, *executor_);
+    interpreter_ = std::make_unique<interp::Interpreter>(*executor_, *machine_, options);
+    interpreter_->open(cfg_.program_path);
+}
+
+void ProgramRunner::run() noexcept {
+    if (!interpreter_ && !finished_) {
+        try {
+            open_program();
+        } catch (const std::exception& e) {
+            finish(e.what());
+        }
+    }
+    while (!pause_.load(std::memory_order_relaxed)) {
+        const bool all_sent = deliver();
+        if (finished_ && all_sent) break;
+        if (!all_sent) mark_ready();  // the stream is full
+        if (finished_ || outbox_.size() >= kOutboxLimit) {
+            std::this_thread::sleep_for(kPollInterval);
+            continue;
+        }
+        link_.on_progress();
+        if (stopping()) {
+            if (pause_.load(std::memory_order_relaxed)) break;
+            finish(fmt::format("{}: aborted; the rest of the program is given up", where()));
+            continue;
+        }
+        try {
+            if (!interpreter_->step()) finish("");
+        } catch (const Stopped&) {
+            // The block that asked could not be finished: the rest of the program is given up.
+            finish(fmt::format(
+                "{}: {} while waiting for the machine; the rest of the program is given up",
+                where(), abort_.load(std::memory_order_relaxed) ? "aborted" : "stopped"));
+        } catch (const std::exception& e) {
+            finish(e.what());
+        }
+    }
+    link_.on_progress();
+    mark_ready();
+}
+
+}  // namespace interpcomp

@@ -1,0 +1,128 @@
+// The interp component's non-realtime side: a thread that runs the interpreter library on a
+// program and writes its canonical commands, encoded (interp/canon_wire.hpp), into a channel
+// (the HAL stream). Queue-busting reads (#CURMACHPOS, #CURWORKPOS, G906) wait until the
+// consumer has followed everything sent so far and stands in position, then read the
+// machine's live position. HAL-free: interp.cpp adapts it to pins and a stream.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "interp/canon_wire.hpp"
+
+namespace interp {
+class Executor;
+class Interpreter;
+}  // namespace interp
+
+namespace interpcomp {
+
+// The far side of the stream, as the runner's thread sees it. Every call is non-blocking.
+class MachineLink {
+  public:
+    virtual ~MachineLink() = default;
+    // Appends a record to the stream; false when it is full.
+    virtual bool push(const interp::wire::Record& r) noexcept = 0;
+    // Barriers (Sync records) the consumer has reached with the machine in position.
+    virtual std::uint32_t barriers_reached() const noexcept = 0;
+    // Live machine position (mm, degrees for A B C), valid when a barrier was just reached.
+    virtual double machine_pos_mm(int axis) const noexcept = 0;
+    // Polled by the runner's thread: true gives the rest of the program up.
+    virtual bool abort_requested() const noexcept { return false; }
+    // Called by the runner's thread whenever its status (line, waiting, done, failed) may have
+    // changed, so an adapter can publish it.
+    virtual void on_progress() noexcept {}
+};
+
+struct RunnerConfig {
+    std::string program_path;
+    std::string dialect;      // empty: the interpreter's default (ncstudio)
+    bool standalone = false;  // no machine: answer reads from the interpreter's own model
+};
+
+class ProgramRunner {
+  public:
+    ProgramRunner(RunnerConfig cfg, MachineLink& link);
+    ~ProgramRunner();
+    ProgramRunner(const ProgramRunner&) = delete;
+    ProgramRunner& operator=(const ProgramRunner&) = delete;
+
+    // Configuration world. Starts (or resumes) the thread and blocks until the whole program
+    // is in the stream, the stream is full, the runner waits for the machine at a barrier, or
+    // the program failed. Returns true if it had failed by then.
+    bool start_and_wait_ready();
+    // Configuration world: pauses (joins the thread). A runner waiting at a barrier gives the
+    // rest of the program up (it cannot pause inside a block).
+    void stop();
+    // Gives the rest of the program up: an end record with "aborted" follows what was sent.
+    void abort() noexcept { abort_.store(true, std::memory_order_relaxed); }
+
+    // Any thread.
+    bool done() const noexcept { return done_.load(std::memory_order_acquire); }
+    bool failed() const noexcept { return failed_.load(std::memory_order_acquire); }
+    bool waiting() const noexcept { return waiting_.load(std::memory_order_relaxed); }
+    bool running() const noexcept { return running_.load(std::memory_order_relaxed); }
+    int line() const noexcept { return line_.load(std::memory_order_relaxed); }
+    std::uint32_t barriers_sent() const noexcept { return barriers_.load(std::memory_order_relaxed); }
+    // "file:line:col: reason", once failed() is true.
+    std::string error() const;
+    // Configuration world, while stopped: the end record (with any error) is in the stream.
+    bool end_sent() const noexcept { return finished_ && outbox_.empty(); }
+
+    // Used by the runner's sink and machine query, on the runner's thread.
+    void send(const interp::Canon& c);
+    // Sends a barrier at `loc` and waits until the machine has reached it in position.
+    void sync(const interp::SourceLoc& loc);
+    // True when nothing was sent since the last barrier was reached: the machine is current.
+    bool machine_current() const noexcept { return current_; }
+
+  private:
+    class Sink;
+    class LiveMachine;
+    struct Stopped {};  // unwinds a barrier wait when the runner is stopped or aborted
+
+    void run() noexcept;
+    void open_program();
+    bool deliver() noexcept;  // outbox -> stream as far as it fits; true when all went
+    void finish(const std::string& error);
+    void mark_ready();
+    bool stopping() noexcept;
+    std::string where() const;  // "file:line:col" of the last command sent, or the program
+
+    RunnerConfig cfg_;
+    MachineLink& link_;
+    interp::wire::Encoder encoder_;
+    std::unique_ptr<Sink> sink_;
+    std::unique_ptr<interp::Executor> executor_;
+    std::unique_ptr<LiveMachine> machine_;
+    std::unique_ptr<interp::Interpreter> interpreter_;
+    std::deque<interp::wire::Record> outbox_;
+    std::vector<interp::wire::Record> scratch_;
+    interp::SourceLoc last_loc_;
+    bool finished_ = false;  // the end record is in the outbox
+    bool current_ = false;
+
+    std::thread thread_;
+    std::atomic<bool> pause_{false};
+    std::atomic<bool> abort_{false};
+    std::atomic<bool> done_{false};
+    std::atomic<bool> failed_{false};
+    std::atomic<bool> waiting_{false};
+    std::atomic<bool> running_{false};
+    std::atomic<int> line_{0};
+    std::atomic<std::uint32_t> barriers_{0};
+
+    mutable std::mutex mutex_;
+    std::condition_variable ready_cv_;
+    bool ready_ = false;
+    bool failed_at_ready_ = false;
+    std::string error_;
+};
+
+}  // namespace interpcomp
