@@ -217,7 +217,7 @@ TEST(PreviewKinds, ClassifiesProgramLinesFromTheCanonicalStream) {
     ScratchDir dir;
     const auto path = (dir.path() / "kinds.ngc").string();
     std::ofstream(path) << "G90 G21 G17\nG0 X10\nG1 X20 F100\nG2 X30 I5 J0\nM3 S1000\nM30\n";
-    const std::vector<MoveKind> kinds = cncrun::classify_lines(path, "ncstudio");
+    const std::vector<MoveKind> kinds = cncrun::classify_lines(path, "ncstudio").line_kinds;
     ASSERT_GE(kinds.size(), 5u);
     EXPECT_EQ(kinds[1], MoveKind::Other);
     EXPECT_EQ(kinds[2], MoveKind::Rapid);
@@ -227,6 +227,51 @@ TEST(PreviewKinds, ClassifiesProgramLinesFromTheCanonicalStream) {
         EXPECT_EQ(kinds[5], MoveKind::Other);
     }
 }
+
+// A G81 drilling cycle on two holes; each cycle line rapids over and down to R2, feeds to
+// Z-5 and rapids back up to Z10 (G98). By hand: per hole 7 mm of feed, 10 + 8 + 15 mm of rapid.
+class CannedCycle : public ::testing::TestWithParam<Point> {
+  protected:
+    void SetUp() override {
+        const auto path = (dir_.path() / "g81.ngc").string();
+        std::ofstream(path)
+            << "G90 G21 G17 G98\nG0 X0 Y0 Z10\nG81 X10 Y0 Z-5 R2 F100\nX20\nG80\nM30\n";
+        moves_ = cncrun::classify_lines(path, "ncstudio");
+    }
+    ScratchDir dir_;
+    cncrun::ProgramMoves moves_;
+};
+
+TEST_P(CannedCycle, RapidsAndFeedsWithinACycleLineAreToldApart) {
+    ASSERT_EQ(moves_.mixed_lines.count(3), 1u);
+    ASSERT_EQ(moves_.mixed_lines.count(4), 1u);
+    // The machine's positions are the program's plus a work offset (the parameter): the
+    // stretches are displacements, so the offset changes nothing.
+    const Point o = GetParam();
+    const auto at = [&](double x, double y, double z) {
+        return Point{x + o[0], y + o[1], z + o[2]};
+    };
+    Preview p(moves_);
+    p.add(at(0, 0, 10), 2);
+    Point here = at(0, 0, 10);
+    for (int line : {3, 4}) {
+        const double x = line == 3 ? 10 : 20;
+        for (const Point& to : {at(x, 0, 10), at(x, 0, 2), at(x, 0, -5), at(x, 0, 10)}) {
+            move(p, here, to, line);
+            here = to;
+        }
+    }
+    // One 0.1 mm sample step at each change of kind may fall either side.
+    EXPECT_NEAR(p.feed_length_mm(), 2 * 7, 0.25);
+    EXPECT_NEAR(p.rapid_length_mm(), 2 * (10 + 8 + 15), 0.25);
+    std::vector<MoveKind> kinds;
+    for (const auto& r : p.runs()) kinds.push_back(r.kind);
+    EXPECT_EQ(kinds, (std::vector<MoveKind>{MoveKind::Rapid, MoveKind::Feed, MoveKind::Rapid,
+                                            MoveKind::Feed, MoveKind::Rapid}));
+}
+
+INSTANTIATE_TEST_SUITE_P(Offsets, CannedCycle,
+                         ::testing::Values(Point{0, 0, 0}, Point{100, -50, -20}));
 
 TEST(PreviewKinds, BadProgramIsAnErrorNamingTheFile) {
     ScratchDir dir;
@@ -367,7 +412,7 @@ TEST(PreviewSvg, IsWellFormedWithDashedRapidsAndSolidFeeds) {
 
 TEST(PreviewEdgeCases, EmptyProgramDrawsEmptyPanels) {
     ScratchDir dir;
-    const Preview p({});
+    const Preview p(cncrun::ProgramMoves{});
     for (const char* name : {"empty.png", "empty.svg"})
         ASSERT_NO_THROW(p.write((dir.path() / name).string(), PreviewCaption{"empty.ngc", "", 0}));
     const Png png(dir.path() / "empty.png");

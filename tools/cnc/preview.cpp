@@ -8,6 +8,7 @@
 #include <cctype>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <memory>
 #include <stdexcept>
 #include <type_traits>
@@ -442,8 +443,9 @@ void draw_panel(cairo_t* cr, const ViewDrawing& d, const Extents& e) {
     cairo_clip(cr);
     cairo_set_line_join(cr, CAIRO_LINE_JOIN_ROUND);
     cairo_set_line_cap(cr, CAIRO_LINE_CAP_BUTT);
-    stroke(cr, d.feeds, MoveKind::Feed);
+    // Feeds over rapids: where a peck cycle retracts along the hole, the cut shows.
     stroke(cr, d.rapids, MoveKind::Rapid);
+    stroke(cr, d.feeds, MoveKind::Feed);
     markers(cr, d.fit, v, e.start, e.end);
     cairo_restore(cr);
 }
@@ -513,32 +515,61 @@ std::string lower_extension(const std::string& path) {
     return ext;
 }
 
-// One line kind per servo sample's line number, continuing the current kind for other lines.
+// Each main-file line's moves from the canonical stream: their kinds, and their displacements
+// for the lines that mix rapids and feeds.
 class LineKinds : public interp::CanonSink {
   public:
     void emit(const interp::Canon& c) override {
-        const MoveKind kind = std::visit(
-            [](const auto& cmd) {
+        MoveKind kind = MoveKind::Other;
+        Point end{};
+        std::visit(
+            [&](const auto& cmd) {
                 using T = std::decay_t<decltype(cmd)>;
-                if constexpr (std::is_same_v<T, interp::canon::Traverse>) return MoveKind::Rapid;
-                if constexpr (std::is_same_v<T, interp::canon::FeedLine> ||
-                              std::is_same_v<T, interp::canon::Arc>)
-                    return MoveKind::Feed;
-                return MoveKind::Other;
+                if constexpr (std::is_same_v<T, interp::canon::Traverse> ||
+                              std::is_same_v<T, interp::canon::FeedLine> ||
+                              std::is_same_v<T, interp::canon::Arc>) {
+                    kind = std::is_same_v<T, interp::canon::Traverse> ? MoveKind::Rapid
+                                                                      : MoveKind::Feed;
+                    end = {cmd.end_mm[0], cmd.end_mm[1], cmd.end_mm[2]};
+                }
             },
             c.cmd);
-        if (kind == MoveKind::Other || c.loc.line < 0 || c.loc.file != main_file) return;
-        const auto line = static_cast<std::size_t>(c.loc.line);
-        if (kinds.size() <= line) kinds.resize(line + 1, MoveKind::Other);
-        if (kinds[line] != MoveKind::Feed) kinds[line] = kind;
+        if (kind == MoveKind::Other) return;
+        const Point delta{end[0] - last_end_[0], end[1] - last_end_[1], end[2] - last_end_[2]};
+        last_end_ = end;
+        if (c.loc.line < 0 || c.loc.file != main_file) return;
+        // Every move is a stretch of its own, even next to one of the same kind: a peck
+        // cycle's rapid up and back down would sum to a short hop the samples run past.
+        line_moves_[c.loc.line].push_back({kind, delta});
     }
+
+    ProgramMoves result() const {
+        ProgramMoves out;
+        for (const auto& [line, moves] : line_moves_) {
+            const auto at = static_cast<std::size_t>(line);
+            if (out.line_kinds.size() <= at) out.line_kinds.resize(at + 1, MoveKind::Other);
+            const bool feeds = std::any_of(moves.begin(), moves.end(), [](const LineMove& m) {
+                return m.kind == MoveKind::Feed;
+            });
+            const bool rapids = std::any_of(moves.begin(), moves.end(), [](const LineMove& m) {
+                return m.kind == MoveKind::Rapid;
+            });
+            out.line_kinds[at] = feeds ? MoveKind::Feed : MoveKind::Rapid;
+            if (feeds && rapids) out.mixed_lines[line] = moves;
+        }
+        return out;
+    }
+
     std::string main_file;
-    std::vector<MoveKind> kinds;
+
+  private:
+    Point last_end_{};
+    std::map<int, std::vector<LineMove>> line_moves_;
 };
 
 }  // namespace
 
-std::vector<MoveKind> classify_lines(const std::string& program, const std::string& dialect) {
+ProgramMoves classify_lines(const std::string& program, const std::string& dialect) {
     LineKinds sink;
     sink.main_file = program;
     interp::Settings settings;
@@ -550,7 +581,7 @@ std::vector<MoveKind> classify_lines(const std::string& program, const std::stri
     in.open(program);
     while (in.step()) {
     }
-    return sink.kinds;
+    return sink.result();
 }
 
 std::string preview_path_error(const std::string& path) {
@@ -574,17 +605,57 @@ PixelBox plot_box(View view) {
             p.h - kCaptionPx - kFooterPx};
 }
 
-Preview::Preview(std::vector<MoveKind> line_kinds, PreviewLimits limits)
-    : line_kinds_(std::move(line_kinds)),
+Preview::Preview(ProgramMoves moves, PreviewLimits limits)
+    : moves_(std::move(moves)),
       limits_(limits),
       tolerance_mm_(kInitialToleranceMm),
       error_bound_mm_(kInitialToleranceMm) {
     limits_.max_points = std::max(limits_.max_points, kMinStoredPoints);
 }
 
-MoveKind Preview::kind_of(int line) const {
-    const MoveKind kind = line >= 0 && static_cast<std::size_t>(line) < line_kinds_.size()
-                              ? line_kinds_[static_cast<std::size_t>(line)]
+// Within a mixed line a sample moves on to the next stretch once it has come within this of
+// the current stretch's end or passed it, or is this much nearer the next stretch (a blended
+// corner turns before the end): about a blend tolerance, less than a canned cycle's stretches.
+constexpr double kStretchEndMm = 0.05;
+
+MoveKind Preview::kind_of(int line, const Point& xyz_mm) {
+    const auto mixed = moves_.mixed_lines.find(line);
+    if (mixed != moves_.mixed_lines.end()) {
+        const std::vector<LineMove>& stretches = mixed->second;
+        const auto end_of = [&](const Point& from, std::size_t i) {
+            const auto& d = stretches[i].delta_mm;
+            return Point{from[0] + d[0], from[1] + d[1], from[2] + d[2]};
+        };
+        if (cursor_.line != line) {
+            // The line starts where the machine was: the sample before this one.
+            const Point start = samples_ > 0 ? end_ : xyz_mm;
+            cursor_ = {line, 0, start, end_of(start, 0)};
+        }
+        while (cursor_.stretch + 1 < stretches.size()) {
+            const Point& end = cursor_.end_mm;
+            const auto& d = stretches[cursor_.stretch].delta_mm;
+            const double len = std::hypot(d[0], d[1], d[2]);
+            const double along = len > 0
+                                     ? ((xyz_mm[0] - end[0]) * d[0] + (xyz_mm[1] - end[1]) * d[1] +
+                                        (xyz_mm[2] - end[2]) * d[2]) /
+                                           len
+                                     : 0;
+            const Point next_end = end_of(end, cursor_.stretch + 1);
+            const bool reached = along >= -kStretchEndMm || distance(xyz_mm, end) <= kStretchEndMm;
+            const bool nearer_next =
+                distance_to_segment(xyz_mm, end, next_end) <
+                distance_to_segment(xyz_mm, cursor_.start_mm, end) - kStretchEndMm;
+            if (!reached && !nearer_next) break;
+            ++cursor_.stretch;
+            cursor_.start_mm = end;
+            cursor_.end_mm = next_end;
+        }
+        return stretches[cursor_.stretch].kind;
+    }
+    cursor_.line = -1;
+    const auto& kinds = moves_.line_kinds;
+    const MoveKind kind = line >= 0 && static_cast<std::size_t>(line) < kinds.size()
+                              ? kinds[static_cast<std::size_t>(line)]
                               : MoveKind::Other;
     if (kind != MoveKind::Other) return kind;
     return runs_.empty() ? MoveKind::Rapid : runs_.back().kind;
@@ -592,7 +663,7 @@ MoveKind Preview::kind_of(int line) const {
 
 void Preview::add(const Point& xyz_mm, int line) {
     if (!std::isfinite(xyz_mm[0]) || !std::isfinite(xyz_mm[1]) || !std::isfinite(xyz_mm[2])) return;
-    const MoveKind kind = kind_of(line);
+    const MoveKind kind = kind_of(line, xyz_mm);
     if (samples_ == 0) {
         start_ = lo_ = hi_ = xyz_mm;
     } else {

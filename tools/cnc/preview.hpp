@@ -14,16 +14,29 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace cncrun {
 
 enum class MoveKind : std::uint8_t { Other, Rapid, Feed };
 
-// For each line of the main program (index = line number), whether it moves at the rapid or
-// the feed rate, from the interpreter's canonical stream. A line with both (a canned cycle)
-// counts as feed. Throws interp::Error (`file:line:col: reason`) for a bad program.
-std::vector<MoveKind> classify_lines(const std::string& program, const std::string& dialect);
+// One move of a line that both rapids and feeds (a canned cycle), as the displacement from
+// the move before: a work offset moves the whole line and changes none.
+struct LineMove {
+    MoveKind kind;
+    std::array<double, 3> delta_mm;
+};
+
+struct ProgramMoves {
+    std::vector<MoveKind> line_kinds;  // index = line number; a mixed line counts as feed
+    std::unordered_map<int, std::vector<LineMove>> mixed_lines;  // lines with both kinds
+};
+
+// For each line of the main program, whether it moves at the rapid or the feed rate, from
+// the interpreter's canonical stream. Throws interp::Error (`file:line:col: reason`) for a
+// bad program.
+ProgramMoves classify_lines(const std::string& program, const std::string& dialect);
 
 // Empty when `path` ends in .png or .svg (any case); otherwise why --preview cannot write it,
 // naming the file.
@@ -57,9 +70,12 @@ struct PreviewCaption {
 
 class Preview {
   public:
-    explicit Preview(std::vector<MoveKind> line_kinds, PreviewLimits limits = {});
+    explicit Preview(ProgramMoves moves, PreviewLimits limits = {});
+    explicit Preview(std::vector<MoveKind> line_kinds, PreviewLimits limits = {})
+        : Preview(ProgramMoves{std::move(line_kinds), {}}, limits) {}
     // One sample of the commanded position (mm) and the program line it belongs to. A line
-    // that is neither rapid nor feed (or unknown) continues the current kind.
+    // that is neither rapid nor feed (or unknown) continues the current kind; within a mixed
+    // line the kind follows the line's stretches as the samples reach each one's end.
     void add(const std::array<double, 3>& xyz_mm, int line);
     // Writes a PNG or an SVG, chosen by the file's extension. Throws std::runtime_error naming
     // the file for another extension or when it cannot be written.
@@ -82,9 +98,18 @@ class Preview {
 
   private:
     void compact();
-    MoveKind kind_of(int line) const;
+    MoveKind kind_of(int line, const Point& xyz_mm);
 
-    std::vector<MoveKind> line_kinds_;
+    // Where the samples are in a mixed line: its stretch, and where that stretch starts and
+    // ends.
+    struct MixedCursor {
+        int line = -1;
+        std::size_t stretch = 0;
+        Point start_mm{}, end_mm{};
+    };
+
+    ProgramMoves moves_;
+    MixedCursor cursor_;
     PreviewLimits limits_;
     std::vector<Run> runs_;
     // Samples since the last stored vertex of the open run, all within tolerance_mm_ of the
