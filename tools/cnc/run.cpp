@@ -778,8 +778,7 @@ int run_session(const RunOptions& o, const Config& c, Session& session, const St
     print_summary(o, c, pins, r, stats, error);
     if (preview) {
         try {
-            preview->write_svg(o.preview_path,
-                               fmt::format("{} on {}: {:.3f} s", o.program, o.ini, r.last.t_s));
+            preview->write(o.preview_path, PreviewCaption{o.program, o.ini, r.last.t_s});
         } catch (const std::runtime_error& e) {
             fmt::print(stderr, "{}\n", e.what());
             return 1;
@@ -806,14 +805,9 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& o) {
     cmd->add_option("--trace", o.trace_path,
                     "CSV of t,line,axes,joints,vel, one row per servo cycle");
     cmd->add_option("--preview", o.preview_path,
-                    "SVG picture of the path followed (XY, XZ, YZ views; feeds and rapids)")
-        ->check(CLI::Validator(
-            [](std::string& path) {
-                return path.size() > 4 && path.compare(path.size() - 4, 4, ".svg") == 0
-                           ? std::string{}
-                           : "--preview writes SVG: the file name must end in .svg";
-            },
-            "FILE.svg"));
+                    "PNG or SVG picture of the path followed (top, front, side and isometric "
+                    "views; feeds and rapids)")
+        ->check(CLI::Validator(preview_path_error, "FILE.png|FILE.svg"));
     cmd->add_option("--timeout", o.timeout_s, "give up after this much motion time, s")
         ->check(CLI::PositiveNumber);
     return cmd;
