@@ -1,7 +1,10 @@
 // motion: the trajectory controller. A non-realtime planner thread (program_feeder.cpp) runs a
 // G-code program through the interpreter and the look-ahead planner; the realtime function
 // `motion-controller` samples the planned trajectory once per servo period, applies overrides,
-// feed hold and abort, and writes LinuxCNC-named axis and joint pins.
+// feed hold and abort, and writes LinuxCNC-named axis and joint pins. Machine commands of the
+// program (spindle, coolant, tool change, digital outputs and inputs, M00/M01) reach it as
+// action records in the same ring, in program order, and are carried out here on the pins
+// LinuxCNC's motion and iocontrol publish (spindle.0.*, iocontrol.0.*, motion.digital-*).
 //
 // Kinematics inside this component are trivial (joint N follows the axis named by the N-th
 // letter of coordinates=); the kins_* components exist for other machines, wired externally
@@ -30,6 +33,22 @@ namespace {
 constexpr char kLowerAxes[] = "xyzabcuvw";
 constexpr char kUpperAxes[] = "XYZABCUVW";
 constexpr double kMaxOverride = 1.2;
+constexpr long kMaxDio = 64;  // NcStudio's M901 H0..H63
+
+// Why motion faulted, kept by the servo function for the text printed in the configuration
+// world (stop or unload). Drive faults and following errors are told by their own pins.
+enum class FaultCause : std::uint8_t { None, EStop, PosLimit, NegLimit, WaitTimeout };
+struct FaultReport {
+    FaultCause cause = FaultCause::None;
+    int joint = 0;
+    std::int32_t line = 0;
+    motion::Action action;
+};
+
+// The e-stop handshake of LinuxCNC's iocontrol: iocontrol.0.emc-enable-in FALSE trips it
+// (user-enable-out drops with it); a rising motion.enable asks for a reset (user-enable-out
+// TRUE again), and the machine is ready once emc-enable-in is TRUE.
+enum class EStop : std::uint8_t { Ready, Tripped, Resetting };
 
 struct AxisPins {
     int axis;  // index into motion::AxisArray
@@ -37,6 +56,8 @@ struct AxisPins {
     std::unique_ptr<hal::Param<double>> max_velocity;
     std::unique_ptr<hal::Param<double>> max_acceleration;
     std::unique_ptr<hal::Param<double>> max_jerk;
+    std::unique_ptr<hal::Param<double>> min_limit;
+    std::unique_ptr<hal::Param<double>> max_limit;
 };
 
 std::string upper(std::string s) {
@@ -66,6 +87,9 @@ class Motion : public hal::Instance {
           motor_pos_fb_(this, pin("joint.{}.motor-pos-fb"), joint_count_),
           f_error_(this, pin("joint.{}.f-error"), joint_count_),
           amp_enable_out_(this, pin("joint.{}.amp-enable-out"), joint_count_),
+          num_dio_(read_num_dio()),
+          digital_out_(this, pin("motion.digital-out-{:02}"), num_dio_),
+          digital_in_(this, pin("motion.digital-in-{:02}"), num_dio_),
           ring_(ring_capacity()) {
         check_num_joints();
         program_path_ = arg("program").value_or("");
@@ -85,6 +109,8 @@ class Motion : public hal::Instance {
         lockstep_ = arg_int("sim_lockstep", 0) != 0;
         make_axis_pins();
         joint_cmd_mm_.assign(joint_count_, 0.0);
+        pos_lim_seen_.assign(joint_count_, 0);
+        neg_lim_seen_.assign(joint_count_, 0);
         shared_function<&Motion::update>("=motion-controller");
     }
 
@@ -110,6 +136,7 @@ class Motion : public hal::Instance {
         cfg.coordinates = coordinates_;
         for (char c : coordinates_) cfg.axis_present[motion::axis_index(c)] = true;
         cfg.blend_tolerance_mm = blend_tolerance_mm_;
+        cfg.machine = sink_config();
         feeder_ = std::make_unique<motioncomp::ProgramFeeder>(std::move(cfg), ring_);
         const bool failed_early = feeder_->start_and_wait_ready();
         // An error found before the first servo period is a configuration error: say so now,
@@ -126,31 +153,40 @@ class Motion : public hal::Instance {
     }
 
     void stop() override {
-        if (!feeder_) return;
-        feeder_->stop();
+        if (feeder_) feeder_->stop();
         report_late_error();
     }
 
     ~Motion() override {
-        if (!feeder_) return;
-        feeder_->stop();
+        if (feeder_) feeder_->stop();
         report_late_error();
     }
 
     void update(hal::Period p) noexcept {
         if (!sampler_) return;  // start() failed: nothing planned, nothing to command
         const bool enable = enable_;
-        if (enable && !enable_seen_) drive_fault_ = false;  // re-enabling clears a drive fault
+        const bool enable_rose = enable && !enable_seen_;
         enable_seen_ = enable;
-        apply_abort(abort_ || drive_fault_);
-        const bool enabled = enable && !drive_fault_;
+        const bool resume = resume_;
+        resume_rose_ = resume && !resume_seen_;
+        resume_seen_ = resume;
+        if (enable_rose) clear_latches();
+        update_estop();
+        check_limit_switches(enable);
+        const bool faulted =
+            drive_fault_ || limit_fault_ || estop_ == EStop::Tripped || program_fault_;
+        apply_stops(abort_, faulted);
+        const bool enabled = enable && !faulted && estop_ == EStop::Ready;
 
-        if (lockstep_ && feeder_ && !abort_seen_) feeder_->wait_for_lead();
+        if (lockstep_ && feeder_ && !stop_seen_) feeder_->wait_for_lead();
         sampler_->set_feed_override(clamp_override(feed_override_));
         sampler_->set_rapid_override(clamp_override(rapid_override_));
         sampler_->set_hold(feed_hold_ || !enabled);
+        sampler_->set_single_block(single_block_);
+        if (resume_rose_ && sampler_->status().block_paused) sampler_->resume_block();
         const motion::MotionSample s = sampler_->advance(p.s);
         const motion::SamplerStatus& st = sampler_->status();
+        if (enabled) run_pending_action(s.line, p.s);
 
         for (const AxisPins& a : axes_) *a.pos_cmd = s.pos_mm[a.axis];
         kins_.inverse(s.pos_mm, joint_cmd_mm_);
@@ -162,12 +198,15 @@ class Motion : public hal::Instance {
         for (double v : s.vel_mm_s) v2 += v * v;
         current_vel_ = std::sqrt(v2);
         program_line_ = s.line;
+        last_line_ = s.line;
         const bool planning = feeder_ && !feeder_->idle();
         const bool queue_empty = st.done || ring_.size() == 0 || st.aborted;
         const bool in_position = !st.moving && queue_empty && !planning;
         in_position_ = in_position;
         if (feeder_) canon_sync_ = feeder_->acknowledge(in_position);
-        fault_ = drive_fault_ || (feeder_ && feeder_->failed());
+        program_paused_ = st.block_paused || pausing_;
+        fault_ = drive_fault_ || limit_fault_ || estop_ == EStop::Tripped || program_fault_ ||
+                 (feeder_ && feeder_->failed());
         if (st.starved) starved_periods_ = ++starved_count_;
         ignored_commands_ = feeder_ ? feeder_->ignored_commands() : 0u;
     }
@@ -181,14 +220,213 @@ class Motion : public hal::Instance {
         return true;
     }
 
-    // Abort on a rising edge: a controlled stop, and the rest of the program is given up.
-    void apply_abort(bool request) noexcept {
-        if (request && !abort_seen_) {
-            sampler_->abort();
-            if (feeder_) feeder_->abandon();
+    // A rising motion.abort stops along the path within the jerk limit; a fault stops at the
+    // acceleration limit. Either gives the rest of the program up and turns the spindle and
+    // coolant off; when both requests are gone the sampler accepts records again.
+    void apply_stops(bool user_abort, bool fault) noexcept {
+        if (fault && !fault_seen_) {
+            sampler_->fault_stop();
+            give_up();
         }
-        if (!request && abort_seen_) sampler_->clear_abort();
-        abort_seen_ = request;
+        if (user_abort && !abort_seen_) {
+            sampler_->abort();
+            give_up();
+        }
+        const bool request = user_abort || fault;
+        if (!request && stop_seen_) sampler_->clear_abort();
+        abort_seen_ = user_abort;
+        fault_seen_ = fault;
+        stop_seen_ = request;
+    }
+
+    void give_up() noexcept {
+        if (feeder_) feeder_->abandon();
+        spindle_dir_ = 0;
+        write_spindle();
+        spindle_orient_ = false;
+        coolant_flood_ = false;
+        coolant_mist_ = false;
+        tool_prepare_ = false;
+        tool_change_ = false;
+        pausing_ = false;
+        action_started_ = false;
+    }
+
+    // A rising motion.enable clears latched faults (the e-stop needs its own reset, below).
+    void clear_latches() noexcept {
+        drive_fault_ = false;
+        limit_fault_ = false;
+        if (estop_ == EStop::Tripped) estop_ = EStop::Resetting;
+    }
+
+    void update_estop() noexcept {
+        const bool ok = emc_enable_in_;
+        if (!ok && estop_ == EStop::Ready) {
+            estop_ = EStop::Tripped;
+            note_fault({FaultCause::EStop, 0, last_line_, {}});
+        } else if (ok && estop_ == EStop::Resetting) {
+            estop_ = EStop::Ready;
+        }
+        user_enable_out_ = estop_ != EStop::Tripped;
+        if (estop_ == EStop::Tripped)
+            for (std::size_t j = 0; j < joint_count_; ++j) amp_enable_out_[j] = false;
+    }
+
+    // A limit switch that closes while the machine is enabled trips a fault. A switch still
+    // closed after the fault is cleared does not trip again, so the axis can be moved off it.
+    void check_limit_switches(bool enable) noexcept {
+        for (std::size_t j = 0; j < joint_count_; ++j) {
+            const bool pos = pos_lim_sw_in_[j], neg = neg_lim_sw_in_[j];
+            const bool rose_pos = pos && !pos_lim_seen_[j], rose_neg = neg && !neg_lim_seen_[j];
+            pos_lim_seen_[j] = pos;
+            neg_lim_seen_[j] = neg;
+            if (!enable || limit_fault_ || !(rose_pos || rose_neg)) continue;
+            limit_fault_ = true;
+            const FaultCause cause = rose_pos ? FaultCause::PosLimit : FaultCause::NegLimit;
+            note_fault({cause, static_cast<int>(j), last_line_, {}});
+            for (std::size_t k = 0; k < joint_count_; ++k) amp_enable_out_[k] = false;
+        }
+    }
+
+    // The first fault is the one reported.
+    void note_fault(const FaultReport& r) noexcept {
+        if (report_.cause == FaultCause::None) report_ = r;
+    }
+
+    // ---- machine commands (action records) ----
+
+    void write_spindle() noexcept {
+        const double rpm = spindle_dir_ * spindle_rpm_;
+        spindle_speed_out_ = rpm;
+        spindle_speed_out_abs_ = std::fabs(rpm);
+        spindle_on_ = spindle_dir_ != 0;
+        spindle_forward_ = spindle_dir_ > 0;
+        spindle_reverse_ = spindle_dir_ < 0;
+    }
+
+    // Carries out the action the sampler stands on, over as many periods as it takes; tells
+    // the sampler when it is complete. A handshake input is read from the period after its
+    // output was set, so a drive or a loopback has one period to answer.
+    void run_pending_action(std::int32_t line, double dt) noexcept {
+        const motion::Action* a = sampler_->pending_action();
+        if (!a) {
+            action_started_ = false;
+            return;
+        }
+        const bool first = !action_started_;
+        if (first) {
+            action_started_ = true;
+            action_stage_ = 0;
+            action_waited_s_ = 0;
+        } else {
+            action_waited_s_ += dt;
+        }
+        if (step_action(*a, first, line)) {
+            action_started_ = false;
+            sampler_->action_done();
+        }
+    }
+
+    bool step_action(const motion::Action& a, bool first, std::int32_t line) noexcept {
+        switch (a.kind) {
+            case motion::ActionKind::SpindleSpeed:
+                if (first) spindle_rpm_ = a.number;
+                return spindle_command(first);
+            case motion::ActionKind::Spindle:
+                if (first) spindle_dir_ = a.value;
+                return spindle_command(first);
+            case motion::ActionKind::SpindleOrient:
+                return orient_spindle(a, first);
+            case motion::ActionKind::Coolant:
+                coolant_flood_ = a.flag;
+                if (!a.flag) coolant_mist_ = false;  // M09: all coolant off
+                return true;
+            case motion::ActionKind::ToolChange:
+                return change_tool(a.value, first);
+            case motion::ActionKind::SetToolNumber:
+                tool_number_ = a.value;
+                return true;
+            case motion::ActionKind::SetOutput:
+                digital_out_[static_cast<std::size_t>(a.value)] = a.flag;
+                return true;
+            case motion::ActionKind::WaitInput:
+                return wait_input(a, line);
+            case motion::ActionKind::Pause:
+                return pause(first);
+            case motion::ActionKind::OptionalPause:
+                return !optional_stop_ || pause(first);
+            case motion::ActionKind::None:
+                break;
+        }
+        return true;
+    }
+
+    // M03/M04/M05/S: the outputs change at once; a running spindle must report at-speed
+    // before motion goes on (LinuxCNC waits for spindle.0.at-speed likewise).
+    bool spindle_command(bool first) noexcept {
+        if (first) {
+            spindle_orient_ = false;
+            write_spindle();
+            return spindle_dir_ == 0;
+        }
+        return spindle_dir_ == 0 || spindle_at_speed_;
+    }
+
+    // M19-like oriented stop: the spindle stops, orient is raised with the angle, and motion
+    // waits for is-oriented. orient stays TRUE until the next spindle command.
+    bool orient_spindle(const motion::Action& a, bool first) noexcept {
+        if (first) {
+            spindle_dir_ = 0;
+            write_spindle();
+            spindle_orient_angle_ = a.number;
+            spindle_orient_ = true;
+            return false;
+        }
+        return spindle_is_oriented_;
+    }
+
+    // LinuxCNC iocontrol's two handshakes: tool-prepare until tool-prepared, then tool-change
+    // until tool-changed; tool-number takes the new tool and tool-prep-number returns to 0.
+    bool change_tool(int tool, bool first) noexcept {
+        if (first) {
+            tool_prep_number_ = tool;
+            tool_prepare_ = true;
+            action_stage_ = 0;
+            return false;
+        }
+        if (action_stage_ == 0) {
+            if (!tool_prepared_) return false;
+            tool_prepare_ = false;
+            tool_change_ = true;
+            action_stage_ = 1;
+            return false;
+        }
+        if (!tool_changed_) return false;
+        tool_change_ = false;
+        tool_number_ = tool;
+        tool_prep_number_ = 0;
+        return true;
+    }
+
+    // G906 PLC[n] LEVEL l P t: waits for the level; past the timeout the program stops with an
+    // error naming its line.
+    bool wait_input(const motion::Action& a, std::int32_t line) noexcept {
+        if (digital_in_[static_cast<std::size_t>(a.value)].get() == a.flag) return true;
+        if (action_waited_s_ + 1e-9 < a.number) return false;
+        program_fault_ = true;
+        note_fault({FaultCause::WaitTimeout, 0, line, a});
+        return false;  // the fault stop discards the queue, this action with it
+    }
+
+    // M00 (and M01 with motion.optional-stop): paused until motion.resume rises.
+    bool pause(bool first) noexcept {
+        if (first) {
+            pausing_ = true;
+            return false;
+        }
+        if (!resume_rose_) return false;
+        pausing_ = false;
+        return true;
     }
 
     // Joint commands, following errors and amp enables; true if a drive reports a fault or a
@@ -213,9 +451,43 @@ class Motion : public hal::Instance {
     // An error met while the program was already running has only the fault pin in realtime;
     // the text is printed here, in the configuration world, once.
     void report_late_error() {
-        if (error_reported_ || !feeder_->failed()) return;
+        if (!fault_reported_ && report_.cause != FaultCause::None) {
+            fault_reported_ = true;
+            fmt::print(stderr, "{}: {}\n", name(), fault_text(report_));
+        }
+        if (error_reported_ || !feeder_ || !feeder_->failed()) return;
         error_reported_ = true;
         fmt::print(stderr, "{}: {}\n", name(), feeder_->error());
+    }
+
+    std::string fault_text(const FaultReport& r) const {
+        switch (r.cause) {
+            case FaultCause::EStop:
+                return fmt::format("e-stop: {} went FALSE; motion stopped, program abandoned",
+                                   pin_name("iocontrol.0.emc-enable-in"));
+            case FaultCause::PosLimit:
+            case FaultCause::NegLimit: {
+                const bool pos = r.cause == FaultCause::PosLimit;
+                return fmt::format(
+                    "joint {} hit its {} limit switch ({}); motion stopped, program abandoned",
+                    r.joint, pos ? "positive" : "negative",
+                    pin_name(fmt::format("joint.{}.{}-lim-sw-in", r.joint, pos ? "pos" : "neg")));
+            }
+            case FaultCause::WaitTimeout:
+                return fmt::format("{}:{}: G906: {} did not become {} within {} s", program_path_,
+                                   r.line,
+                                   pin_name(fmt::format("motion.digital-in-{:02}", r.action.value)),
+                                   r.action.flag ? "TRUE" : "FALSE", r.action.number);
+            case FaultCause::None:
+                break;
+        }
+        return "";
+    }
+
+    // The full name of one of this instance's pins, for messages.
+    std::string pin_name(std::string_view n) const {
+        const std::string p = pin(n);
+        return p[0] == '=' ? p.substr(1) : fmt::format("{}.{}", name(), p);
     }
 
     std::string read_coordinates() const {
@@ -240,6 +512,31 @@ class Motion : public hal::Instance {
         return static_cast<std::size_t>(n);
     }
 
+    std::size_t read_num_dio() const {
+        const long n = arg_int("num_dio", 4);
+        if (n < 1 || n > kMaxDio)
+            throw hal::Error(fmt::format("num_dio={}: must be 1 to {}", n, kMaxDio));
+        return static_cast<std::size_t>(n);
+    }
+
+    // Soft limits and I/O counts, read at start() like the planner's limits.
+    motioncomp::SinkConfig sink_config() const {
+        motioncomp::SinkConfig c;
+        c.min_limit_mm.fill(-1e99);
+        c.max_limit_mm.fill(1e99);
+        for (const AxisPins& a : axes_) {
+            c.min_limit_mm[a.axis] = a.min_limit->get();
+            c.max_limit_mm[a.axis] = a.max_limit->get();
+            if (!(c.min_limit_mm[a.axis] <= c.max_limit_mm[a.axis]))
+                throw hal::Error(fmt::format("{}: axis.{}: min-limit {} is above max-limit {}",
+                                             name(), kLowerAxes[a.axis], c.min_limit_mm[a.axis],
+                                             c.max_limit_mm[a.axis]));
+        }
+        c.digital_outputs = static_cast<int>(num_dio_);
+        c.digital_inputs = static_cast<int>(num_dio_);
+        return c;
+    }
+
     void check_num_joints() const {
         const long n = arg_int("num_joints", static_cast<long>(joint_count_));
         if (n != static_cast<long>(joint_count_))
@@ -260,6 +557,9 @@ class Motion : public hal::Instance {
             a.max_acceleration =
                 std::make_unique<hal::Param<double>>(this, stem + ".max-acceleration", 1000.0);
             a.max_jerk = std::make_unique<hal::Param<double>>(this, stem + ".max-jerk", 0.0);
+            // LinuxCNC's defaults for an axis without MIN_LIMIT / MAX_LIMIT.
+            a.min_limit = std::make_unique<hal::Param<double>>(this, stem + ".min-limit", -1e99);
+            a.max_limit = std::make_unique<hal::Param<double>>(this, stem + ".max-limit", 1e99);
             axes_.push_back(std::move(a));
         }
     }
@@ -275,10 +575,17 @@ class Motion : public hal::Instance {
             plan.limits.acc_mm_s2[a.axis] = a.max_acceleration->get();
             plan.limits.jerk_mm_s3[a.axis] = a.max_jerk->get();
         }
+        // Not 1e9 each: the sampler's rate limits take the smallest acc / vel ratio over all
+        // axes, and 1e9 / 1e9 made resuming from a hold ten times slower than planned.
+        double loosest_vel = 0, loosest_acc = 0;
+        for (const AxisPins& a : axes_) {
+            loosest_vel = std::max(loosest_vel, a.max_velocity->get());
+            loosest_acc = std::max(loosest_acc, a.max_acceleration->get());
+        }
         for (int k = 0; k < motion::kAxes; ++k) {
             if (coordinates_.find(kUpperAxes[k]) != std::string::npos) continue;
-            plan.limits.vel_mm_s[k] = 1e9;
-            plan.limits.acc_mm_s2[k] = 1e9;
+            plan.limits.vel_mm_s[k] = loosest_vel;
+            plan.limits.acc_mm_s2[k] = loosest_acc;
             plan.limits.jerk_mm_s3[k] = 0;
         }
         for (const AxisPins& a : axes_) {
@@ -305,7 +612,38 @@ class Motion : public hal::Instance {
     hal::Array<hal::Out<double>> f_error_lim_{this, pin("joint.{}.f-error-lim"), joint_count_};
     hal::Array<hal::Out<bool>> f_errored_{this, pin("joint.{}.f-errored"), joint_count_};
     hal::Array<hal::Param<double>> max_ferror_{this, pin("joint.{}.max-ferror"), joint_count_};
+    hal::Array<hal::In<bool>> pos_lim_sw_in_{this, pin("joint.{}.pos-lim-sw-in"), joint_count_};
+    hal::Array<hal::In<bool>> neg_lim_sw_in_{this, pin("joint.{}.neg-lim-sw-in"), joint_count_};
+    // Published for LinuxCNC HAL files; homing is not implemented yet, so nothing reads it.
+    hal::Array<hal::In<bool>> home_sw_in_{this, pin("joint.{}.home-sw-in"), joint_count_};
     std::vector<AxisPins> axes_;
+    std::size_t num_dio_;
+    hal::Array<hal::Out<bool>> digital_out_;
+    hal::Array<hal::In<bool>> digital_in_;
+
+    // LinuxCNC motion's spindle 0.
+    hal::Out<double> spindle_speed_out_{this, pin("spindle.0.speed-out")};
+    hal::Out<double> spindle_speed_out_abs_{this, pin("spindle.0.speed-out-abs")};
+    hal::Out<bool> spindle_on_{this, pin("spindle.0.on")};
+    hal::Out<bool> spindle_forward_{this, pin("spindle.0.forward")};
+    hal::Out<bool> spindle_reverse_{this, pin("spindle.0.reverse")};
+    hal::In<bool> spindle_at_speed_{this, pin("spindle.0.at-speed"), true};
+    hal::Out<bool> spindle_orient_{this, pin("spindle.0.orient")};
+    hal::Out<double> spindle_orient_angle_{this, pin("spindle.0.orient-angle")};
+    hal::In<bool> spindle_is_oriented_{this, pin("spindle.0.is-oriented")};
+
+    // LinuxCNC iocontrol's pins.
+    hal::Out<bool> coolant_flood_{this, pin("iocontrol.0.coolant-flood")};
+    hal::Out<bool> coolant_mist_{this, pin("iocontrol.0.coolant-mist")};
+    hal::Out<std::int32_t> tool_prep_number_{this, pin("iocontrol.0.tool-prep-number")};
+    hal::Out<bool> tool_prepare_{this, pin("iocontrol.0.tool-prepare")};
+    hal::In<bool> tool_prepared_{this, pin("iocontrol.0.tool-prepared")};
+    hal::Out<bool> tool_change_{this, pin("iocontrol.0.tool-change")};
+    hal::In<bool> tool_changed_{this, pin("iocontrol.0.tool-changed")};
+    hal::Out<std::int32_t> tool_number_{this, pin("iocontrol.0.tool-number")};
+    // TRUE by default (unlike LinuxCNC's) so a config without an e-stop chain runs.
+    hal::In<bool> emc_enable_in_{this, pin("iocontrol.0.emc-enable-in"), true};
+    hal::Out<bool> user_enable_out_{this, pin("iocontrol.0.user-enable-out"), true};
 
     hal::In<bool> enable_{this, pin("motion.enable")};
     hal::In<bool> feed_hold_{this, pin("motion.feed-hold")};
@@ -318,6 +656,10 @@ class Motion : public hal::Instance {
     hal::Out<bool> fault_{this, pin("motion.fault")};
     hal::Out<std::uint32_t> ignored_commands_{this, pin("motion.ignored-commands")};
     hal::Out<std::uint32_t> starved_periods_{this, pin("motion.starved-periods")};
+    hal::In<bool> optional_stop_{this, pin("motion.optional-stop")};
+    hal::In<bool> single_block_{this, pin("motion.single-block")};
+    hal::In<bool> resume_{this, pin("motion.resume")};
+    hal::Out<bool> program_paused_{this, pin("motion.program-paused")};
     hal::Param<double> blend_tolerance_mm_{this, pin("motion.blend-tolerance"), 0.01};
 
     motion::SpscRing<motion::PreparedSegment> ring_;
@@ -330,14 +672,34 @@ class Motion : public hal::Instance {
     double servo_period_s_ = 1e-3;
     std::vector<double> joint_cmd_mm_;
     bool abort_seen_ = false;
+    bool fault_seen_ = false;
+    bool stop_seen_ = false;  // an abort or a fault stop was requested last period
     bool enable_seen_ = false;
-    bool drive_fault_ = false;  // latched until motion.enable rises again
+    bool resume_seen_ = false;
+    bool resume_rose_ = false;
+    bool drive_fault_ = false;    // latched until motion.enable rises again
+    bool limit_fault_ = false;    // likewise
+    bool program_fault_ = false;  // a G906 timed out: latched for good, like a planner error
+    EStop estop_ = EStop::Resetting;  // ready as soon as emc-enable-in reads TRUE
+    std::vector<char> pos_lim_seen_, neg_lim_seen_;  // last values, for rising edges
+    FaultReport report_;
+    std::int32_t last_line_ = 0;  // motion.program-line as last written
     std::uint32_t starved_count_ = 0;
-    bool lockstep_ = false;
-    bool error_reported_ = false;  // wait for the planner each period (simulated clock only)
+    bool lockstep_ = false;  // wait for the planner each period (simulated clock only)
+    bool error_reported_ = false;
+    bool fault_reported_ = false;
+
+    // Machine-command state.
+    int spindle_dir_ = 0;  // 1 forward, -1 reverse, 0 stopped
+    double spindle_rpm_ = 0;
+    bool pausing_ = false;  // in an M00 / M01 pause
+    bool action_started_ = false;
+    int action_stage_ = 0;
+    double action_waited_s_ = 0;
 };
 
 }  // namespace
 
 HAL_COMPONENT(motion, Motion, "Trajectory planner and servo-rate motion controller", "num_joints",
-              "coordinates", "program", "canon", "dialect", "servo_period_nsec", "queue", "sim_lockstep")
+              "coordinates", "program", "canon", "dialect", "servo_period_nsec", "queue", "sim_lockstep",
+              "num_dio")

@@ -117,7 +117,9 @@ void ProgramFeeder::open_program() {
     interp::InterpreterOptions options;
     options.main_m99_loops = false;  // a looping program would plan forever
     if (!cfg_.dialect.empty()) options.dialect = interp::find_dialect(cfg_.dialect);
-    executor_ = std::make_unique<interp::Executor>(*sink_, interp::BackendConfig{});
+    interp::BackendConfig backend;
+    backend.optional_stop = true;  // M01 reaches motion, which obeys motion.optional-stop
+    executor_ = std::make_unique<interp::Executor>(*sink_, backend);
     interpreter_ = std::make_unique<interp::Interpreter>(*executor_, *executor_, options);
     interpreter_->open(cfg_.program_path);
 }

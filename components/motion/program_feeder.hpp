@@ -26,6 +26,7 @@
 #include "motion/planner.hpp"
 #include "motion/prepared.hpp"
 #include "motion/spsc_ring.hpp"
+#include "plan_sink.hpp"
 
 namespace interp {
 class Executor;
@@ -45,6 +46,7 @@ struct FeederConfig {
     std::array<bool, motion::kAxes> axis_present{};  // axes named by coordinates=
     std::string coordinates;                         // for error messages
     double blend_tolerance_mm = 0;
+    SinkConfig machine;  // soft limits and I/O counts the sink checks moves and commands against
 };
 
 class ProgramFeeder {
