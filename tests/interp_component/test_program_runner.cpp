@@ -1,0 +1,174 @@
+// The interp component's runner (components/interp/program_runner.cpp) against a fake machine
+// that decodes what is sent: a queue-busting read sends a barrier and waits until the machine
+// says it reached it, then reads the live position; without a machine (standalone) it reads
+// the model; an abort while waiting gives the program up with file:line:col.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "interp/canon.hpp"
+#include "interp/canon_wire.hpp"
+#include "program_runner.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using interpcomp::ProgramRunner;
+using interpcomp::RunnerConfig;
+
+// Decodes every record into text lines; the test decides when a barrier counts as reached.
+class FakeMachine : public interpcomp::MachineLink {
+  public:
+    bool push(const interp::wire::Record& r) noexcept override {
+        std::lock_guard lock(mutex_);
+        if (capacity_ == 0) return false;
+        --capacity_;
+        try {
+            switch (decoder_.feed(r)) {
+                case interp::wire::Decoder::Item::Command: {
+                    const interp::Canon& c = decoder_.command();
+                    lines_.push_back(interp::to_text(c));
+                    if (std::holds_alternative<interp::canon::Sync>(c.cmd)) ++barriers_sent_;
+                    break;
+                }
+                case interp::wire::Decoder::Item::End:
+                    lines_.push_back(decoder_.failed() ? "end failed: " + decoder_.error() : "end");
+                    break;
+                case interp::wire::Decoder::Item::None:
+                    break;
+            }
+        } catch (const std::exception& e) {
+            lines_.push_back(std::string("bad record: ") + e.what());
+        }
+        return true;
+    }
+    std::uint32_t barriers_reached() const noexcept override { return reached_.load(); }
+    double machine_pos_mm(int axis) const noexcept override { return axis == 0 ? 7.5 : 0.0; }
+    bool abort_requested() const noexcept override { return abort_.load(); }
+
+    void reach_barriers() { reached_.store(barriers_sent()); }
+    std::uint32_t barriers_sent() const {
+        std::lock_guard lock(mutex_);
+        return barriers_sent_;
+    }
+    std::vector<std::string> lines() const {
+        std::lock_guard lock(mutex_);
+        return lines_;
+    }
+    std::atomic<bool> abort_{false};
+
+  private:
+    mutable std::mutex mutex_;
+    interp::wire::Decoder decoder_;
+    std::vector<std::string> lines_;
+    std::uint32_t barriers_sent_ = 0;
+    std::size_t capacity_ = 1'000'000;
+    std::atomic<std::uint32_t> reached_{0};
+};
+
+class Program {
+  public:
+    explicit Program(const std::string& text)
+        : path_(fs::temp_directory_path() /
+                ("runner_test_" + std::to_string(::getpid()) + "_" + std::to_string(next_++) + ".ngc")) {
+        std::ofstream(path_) << text;
+    }
+    ~Program() { fs::remove(path_); }
+    std::string path() const { return path_.string(); }
+
+  private:
+    static inline int next_ = 0;
+    fs::path path_;
+};
+
+bool eventually(const std::function<bool()>& cond) {
+    for (int i = 0; i < 2000; ++i) {
+        if (cond()) return true;
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    return cond();
+}
+
+constexpr const char* kRead = "G90 G21\nG1 X10 F600\n#1 = #CURMACHPOS.X\nG1 Y=#1\nM30\n";
+
+TEST(ProgramRunner, ReadWaitsAtABarrierThenUsesTheLivePosition) {
+    Program prog(kRead);
+    FakeMachine machine;
+    ProgramRunner runner(RunnerConfig{prog.path(), "", false}, machine);
+    EXPECT_FALSE(runner.start_and_wait_ready());
+    // start returned because the runner waits for the machine: line 2's move and a barrier
+    // were sent, nothing after them.
+    EXPECT_TRUE(eventually([&] { return runner.waiting(); }));
+    EXPECT_EQ(machine.barriers_sent(), 1u);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    EXPECT_FALSE(runner.done());
+    auto lines = machine.lines();
+    ASSERT_GE(lines.size(), 2u);
+    EXPECT_EQ(lines.back(), "2 sync");
+    machine.reach_barriers();
+    ASSERT_TRUE(eventually([&] { return runner.done(); }));
+    runner.stop();
+    lines = machine.lines();
+    // The Y move goes to the machine's X (7.5 from the fake machine), not the model's 10.
+    bool y_from_machine = false;
+    for (const auto& l : lines) y_from_machine = y_from_machine || (l.rfind("4 feed ", 0) == 0 && l.find("Y7.5") != std::string::npos);
+    EXPECT_TRUE(y_from_machine) << ::testing::PrintToString(lines);
+    EXPECT_EQ(lines.back(), "end");
+    EXPECT_FALSE(runner.failed());
+}
+
+TEST(ProgramRunner, StandaloneReadsTheModelWithoutWaiting) {
+    Program prog(kRead);
+    FakeMachine machine;
+    ProgramRunner runner(RunnerConfig{prog.path(), "", true}, machine);
+    EXPECT_FALSE(runner.start_and_wait_ready());
+    ASSERT_TRUE(eventually([&] { return runner.done(); }));
+    runner.stop();
+    bool y_from_model = false;
+    for (const auto& l : machine.lines())
+        y_from_model = y_from_model || (l.rfind("4 feed ", 0) == 0 && l.find("Y10") != std::string::npos);
+    EXPECT_TRUE(y_from_model) << ::testing::PrintToString(machine.lines());
+}
+
+TEST(ProgramRunner, AbortWhileWaitingGivesTheProgramUpWithItsLocation) {
+    Program prog(kRead);
+    FakeMachine machine;
+    ProgramRunner runner(RunnerConfig{prog.path(), "", false}, machine);
+    EXPECT_FALSE(runner.start_and_wait_ready());
+    ASSERT_TRUE(eventually([&] { return runner.waiting(); }));
+    machine.abort_.store(true);
+    ASSERT_TRUE(eventually([&] { return runner.failed(); }));
+    runner.stop();
+    EXPECT_EQ(runner.error(), prog.path() +
+                                  ":2:1: aborted while waiting for the machine; the rest of the "
+                                  "program is given up");
+    const auto lines = machine.lines();
+    EXPECT_EQ(lines.back(), "end failed: " + runner.error());
+}
+
+TEST(ProgramRunner, ASyntaxErrorFailsBeforeStartReturns) {
+    Program prog("G90 G21\nG1 X10 F600\nG1 X20 Q\nM30\n");
+    FakeMachine machine;
+    ProgramRunner runner(RunnerConfig{prog.path(), "", false}, machine);
+    EXPECT_TRUE(runner.start_and_wait_ready());
+    EXPECT_EQ(runner.error(), prog.path() + ":3:8: expected a number or '=' after Q");
+    const auto lines = machine.lines();
+    ASSERT_FALSE(lines.empty());
+    EXPECT_EQ(lines.back(), "end failed: " + runner.error());
+    // Line 2's move went out before the error: the machine runs out what came before it.
+    bool line2 = false;
+    for (const auto& l : lines) line2 = line2 || l.rfind("2 feed ", 0) == 0;
+    EXPECT_TRUE(line2);
+}
+
+}  // namespace
