@@ -8,7 +8,6 @@
 #include <cctype>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <memory>
 #include <stdexcept>
 #include <type_traits>
@@ -538,33 +537,44 @@ class LineKinds : public interp::CanonSink {
         const Point delta{end[0] - last_end_[0], end[1] - last_end_[1], end[2] - last_end_[2]};
         last_end_ = end;
         if (c.loc.line < 0 || c.loc.file != main_file) return;
+        if (c.loc.line != line_) {
+            flush();
+            line_ = c.loc.line;
+        }
         // Every move is a stretch of its own, even next to one of the same kind: a peck
         // cycle's rapid up and back down would sum to a short hop the samples run past.
-        line_moves_[c.loc.line].push_back({kind, delta});
+        moves_.push_back({kind, delta});
     }
 
-    ProgramMoves result() const {
-        ProgramMoves out;
-        for (const auto& [line, moves] : line_moves_) {
-            const auto at = static_cast<std::size_t>(line);
-            if (out.line_kinds.size() <= at) out.line_kinds.resize(at + 1, MoveKind::Other);
-            const bool feeds = std::any_of(moves.begin(), moves.end(), [](const LineMove& m) {
-                return m.kind == MoveKind::Feed;
-            });
-            const bool rapids = std::any_of(moves.begin(), moves.end(), [](const LineMove& m) {
-                return m.kind == MoveKind::Rapid;
-            });
-            out.line_kinds[at] = feeds ? MoveKind::Feed : MoveKind::Rapid;
-            if (feeds && rapids) out.mixed_lines[line] = moves;
-        }
-        return out;
+    ProgramMoves take() {
+        flush();
+        return std::move(out_);
     }
 
     std::string main_file;
 
   private:
+    // Ends a visit to a line: only mixed lines keep their moves, so a program of millions of
+    // lines costs a byte per line. A line visited again (a loop) keeps its first visit's moves.
+    void flush() {
+        if (moves_.empty()) return;
+        const auto has = [&](MoveKind k) {
+            return std::any_of(moves_.begin(), moves_.end(),
+                               [&](const LineMove& m) { return m.kind == k; });
+        };
+        const bool feeds = has(MoveKind::Feed), rapids = has(MoveKind::Rapid);
+        const auto at = static_cast<std::size_t>(line_);
+        auto& kinds = out_.line_kinds;
+        if (kinds.size() <= at) kinds.resize(at + 1, MoveKind::Other);
+        if (kinds[at] != MoveKind::Feed) kinds[at] = feeds ? MoveKind::Feed : MoveKind::Rapid;
+        if (feeds && rapids) out_.mixed_lines.try_emplace(line_, moves_);
+        moves_.clear();
+    }
+
     Point last_end_{};
-    std::map<int, std::vector<LineMove>> line_moves_;
+    int line_ = -1;
+    std::vector<LineMove> moves_;  // of the current visit to line_
+    ProgramMoves out_;
 };
 
 }  // namespace
@@ -581,7 +591,7 @@ ProgramMoves classify_lines(const std::string& program, const std::string& diale
     in.open(program);
     while (in.step()) {
     }
-    return sink.result();
+    return sink.take();
 }
 
 std::string preview_path_error(const std::string& path) {
