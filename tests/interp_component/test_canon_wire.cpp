@@ -51,7 +51,7 @@ std::vector<CanonCommand> samples() {
         canon::Dwell{1.5},
         canon::SetSpindleSpeed{12000},
         canon::Spindle{interp::SpindleDir::Ccw},
-        canon::SpindleOrient{},
+        canon::SpindleOrient{-37.5},
         canon::Coolant{true},
         canon::SpindleClamp{true},
         canon::ToolChange{17},

@@ -73,13 +73,9 @@ template <class A>
 void fields(A& a, canon::Spindle& c) {
     a(c.dir);
 }
-template <class A, class Orient>
-void orient_fields(A& a, Orient& c) {
-    if constexpr (requires { c.tip_angle_deg; }) a(c.tip_angle_deg);
-}
 template <class A>
 void fields(A& a, canon::SpindleOrient& c) {
-    orient_fields(a, c);
+    a(c.tip_angle_deg);
 }
 template <class A>
 void fields(A& a, canon::Coolant& c) {
