@@ -22,6 +22,8 @@ class FakeMachine : public MachineQuery {
     bool incremental = false;
     bool return_to_r = false;
     std::map<std::string, double, std::less<>> settings;
+    bool keeps_settings = false;                        // can_write_setting() answer
+    std::vector<std::pair<std::string, double>> writes;  // write_setting() calls, in order
 
     double machine_pos_mm(Axis a) override { return machine_mm[static_cast<int>(a)]; }
     double work_pos_mm(Axis a) override { return work_mm[static_cast<int>(a)]; }
@@ -35,6 +37,11 @@ class FakeMachine : public MachineQuery {
         auto it = settings.find(name);
         if (it == settings.end()) return std::nullopt;
         return it->second;
+    }
+    bool can_write_setting(std::string_view) override { return keeps_settings; }
+    void write_setting(std::string_view name, double v) override {
+        writes.emplace_back(std::string(name), v);
+        settings[std::string(name)] = v;
     }
 };
 

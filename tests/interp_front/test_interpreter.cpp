@@ -493,3 +493,47 @@ TEST(InterpreterStreaming, LargeFileWithSubprogramAtTheEnd) {
     EXPECT_EQ(e.blocks.back().loc.line, 300002);
     ::unlink(path.c_str());
 }
+
+// TSET-2: #FIXEDCALI_REC is the one named parameter a program writes. The write reaches the
+// machine only after its block executed, in mm, and a rejected block writes nothing.
+TEST_F(InterpFixture, WritableNamedParameterIsStoredAfterItsBlock) {
+    machine.keeps_settings = true;
+    machine.mm_per_unit = 25.4;
+    run("#FIXEDCALI_REC=2 X=#FIXEDCALI_REC\nM30\n");
+    ASSERT_EQ(machine.writes.size(), 1u);
+    EXPECT_EQ(machine.writes[0].first, "FIXEDCALI_REC");
+    EXPECT_DOUBLE_EQ(machine.writes[0].second, 50.8);
+    // Read back in the same block before it was stored: program units.
+    EXPECT_EQ(exec.values('X'), (Values{2.0}));
+}
+
+TEST_F(InterpFixture, WritableNamedParameterOfARejectedBlockIsDropped) {
+    machine.keeps_settings = true;
+    exec.reject_line = 1;
+    EXPECT_EQ(run_error("#FIXEDCALI_REC=2 G01 X1\n"), "main.nc:1:1: rejected by test executor");
+    EXPECT_TRUE(machine.writes.empty());
+}
+
+TEST_F(InterpFixture, WritableNamedParameterNeedsAMachineThatKeepsSettings) {
+    EXPECT_EQ(run_error("#FIXEDCALI_REC=2\n"),
+              "main.nc:1:1: named parameter #FIXEDCALI_REC cannot be stored on this machine (no "
+              "settings file)");
+}
+
+struct WarningList : WarningSink {
+    std::vector<std::string> text;
+    void warning(const SourceLoc& loc, const std::string& t) override {
+        text.push_back(std::string(loc.file) + ":" + std::to_string(loc.line) + ":" +
+                       std::to_string(loc.col) + ": " + t);
+    }
+};
+
+TEST_F(InterpFixture, DuplicateSequenceNumberIsAWarningNotAnError) {
+    WarningList w;
+    options.warnings = &w;
+    run("N5 G1 X1\nN5 G1 X2\nM30\n");
+    EXPECT_EQ(exec.lines(), (Lines{1, 2, 3}));
+    EXPECT_EQ(w.text, (std::vector<std::string>{
+                          "main.nc:2:1: sequence number N5 is used twice in this program; M99 P "
+                          "and searches find the first one"}));
+}

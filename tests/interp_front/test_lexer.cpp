@@ -183,3 +183,18 @@ TEST(LexerErrors, ParenCommentsDisabledByDialect) {
 TEST(LexerErrors, SingleBarOutsideV54) {
     EXPECT_EQ(lex_error("#1=|2|"), "t.nc:7:4: unexpected character '|'");
 }
+
+// Columns count characters, not bytes: each Chinese character below is 3 bytes of UTF-8.
+TEST(Lexer, ColumnsCountCharactersAfterChineseText) {
+    auto t = lex("G00 X1 (快速移动) G33");
+    ASSERT_EQ(t.size(), 7u);
+    EXPECT_EQ(t[4].text, "G");
+    EXPECT_EQ(t[4].col, 15);  // bytes would say 23
+    auto m = lex("M801 MSG \"加工完成\" X2");
+    EXPECT_EQ(m[4].text, "X");
+    EXPECT_EQ(m[4].col, 17);  // bytes would say 25
+}
+
+TEST(Lexer, ErrorColumnAfterChineseComment) {
+    EXPECT_EQ(lex_error("(注释) X1 $"), "t.nc:7:9: unexpected character '$'");
+}

@@ -144,3 +144,16 @@ TEST(Source, StreamsLargeFileAcrossWindowsAndSeeks) {
     EXPECT_EQ(line, "O777");
     ::unlink(path.c_str());
 }
+
+// LEX-07: duplicate sequence numbers are allowed but reported; each O label starts a new scope.
+TEST(SourceScan, DuplicateSequenceNumbersPerProgram) {
+    auto s = Source::from_string("d.nc", "N10 G0\nN20\n N10 X1\nO100\nN10\nN20\n/N20\nM17\n");
+    const auto& d = s->duplicate_sequences();
+    ASSERT_EQ(d.size(), 2u);
+    EXPECT_EQ(d[0].n, 10);
+    EXPECT_EQ(d[0].line, 3);
+    EXPECT_EQ(d[0].col, 2);
+    EXPECT_EQ(d[1].n, 20);
+    EXPECT_EQ(d[1].line, 7);
+    EXPECT_EQ(d[1].col, 2);
+}

@@ -107,8 +107,14 @@ int run_canon(const CommonOptions& o, const std::string& format, const std::stri
     }
     interp::NativePrinter native(out);
     interp::LinuxCncPrinter lcnc(out);
-    interp::CanonSink& sink = format == "linuxcnc" ? static_cast<interp::CanonSink&>(lcnc)
-                                                   : static_cast<interp::CanonSink&>(native);
+    interp::CanonSink& printer = format == "linuxcnc" ? static_cast<interp::CanonSink&>(lcnc)
+                                                      : static_cast<interp::CanonSink&>(native);
+    // Warnings also go to stderr as file:line:col, like errors, without failing the run.
+    interp::WarningPrinter warnings(stderr);
+    interp::TeeSink sink;
+    sink.add(printer);
+    sink.add(warnings);
+    s.iopts.warnings = &warnings;
     interp::Executor exec(sink, s.cfg, s.settings);
     attach_saver(exec, o);
     interp::Interpreter in(exec, exec, s.iopts);
@@ -134,7 +140,12 @@ int run_check(const CommonOptions& o, int max_errors) {
     Session s = make_session(o);
     s.iopts.main_m99_loops = false;  // a checker must terminate
     interp::SummarySink summary;
-    interp::Executor exec(summary, s.cfg, s.settings);  // check never writes settings
+    interp::WarningPrinter warnings(stderr);
+    interp::TeeSink sink;
+    sink.add(summary);
+    sink.add(warnings);
+    s.iopts.warnings = &warnings;
+    interp::Executor exec(sink, s.cfg, s.settings);  // check never writes settings
     interp::Interpreter in(exec, exec, s.iopts);
     if (!o.library.empty()) in.load_library(o.library);
     in.open(o.program);
@@ -150,7 +161,9 @@ int run_check(const CommonOptions& o, int max_errors) {
             }
         }
     }
-    fmt::print("{}: {} error{}\n", o.program, errors, errors == 1 ? "" : "s");
+    const int warned = warnings.count();
+    fmt::print("{}: {} error{}{}\n", o.program, errors, errors == 1 ? "" : "s",
+               warned == 0 ? "" : fmt::format(", {} warning{}", warned, warned == 1 ? "" : "s"));
     if (summary.any_motion()) {
         const auto lo = summary.min_mm(), hi = summary.max_mm();
         fmt::print("extents (machine, mm): X {}  Y {}  Z {}\n", range(lo[0], hi[0]),

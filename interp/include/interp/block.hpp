@@ -145,6 +145,16 @@ struct Block {
     }
 };
 
+// Receives warnings: input that is accepted but is probably not what the program means
+// (a duplicate sequence number, …). A warning never stops the program. Called on the
+// interpreter's thread. The back end's warnings travel in the canonical stream instead
+// (canon::Warning), in program order with the commands they concern.
+class WarningSink {
+  public:
+    virtual ~WarningSink() = default;
+    virtual void warning(const SourceLoc& loc, const std::string& text) = 0;
+};
+
 // The back end. The front end calls execute() once per executable block, in program order, after
 // control flow is resolved. execute() throws interp::Error to reject a block; a rejected block
 // must leave the back end's state unchanged (the front end then rolls back the block's
@@ -185,6 +195,15 @@ class MachineQuery {
     // canonical upper-case name with axis suffix ("SAFEHEIGHT", "BKREF_F1.X", "FIXEDCALI_REC").
     // Lengths in mm. std::nullopt when the machine has no such setting configured.
     virtual std::optional<double> setting(std::string_view name) = 0;
+    // Whether this machine keeps the writable named parameter `name` (#FIXEDCALI_REC, TSET-2).
+    // Asked while the block is parsed, so a refused write rejects the block before anything runs.
+    virtual bool can_write_setting(std::string_view /*name*/) { return false; }
+    // Stores it (lengths in mm) so that it persists. Called after the block that wrote it was
+    // executed, never for a rejected block, and only when can_write_setting() said yes.
+    virtual void write_setting(std::string_view name, double /*value*/) {
+        throw std::logic_error("write_setting(" + std::string(name) +
+                               ") on a machine that keeps no settings");
+    }
 };
 
 }  // namespace interp

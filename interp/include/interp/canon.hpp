@@ -40,15 +40,16 @@ enum class SpindleDir { Stop, Cw, Ccw };
 
 namespace canon {
 
-// Per-block NcStudio move modifiers (G903, G905, G907, G908); all non-modal.
+// Per-block move modifiers (NcStudio G903, G905, G907, G908; G09 from ISO); all non-modal.
 struct MoveFlags {
     bool force_full_override = false;    // G903: feed override fixed at 100 %
     bool force_programmed_feed = false;  // G905: programmed F beats the "default speed" setting
     bool rotary_shortest_path = false;   // G907
     bool rotary_degrees = false;         // G908
+    bool exact_stop = false;             // G09: stop at the end of this move, whatever G64 says
     bool any() const {
         return force_full_override || force_programmed_feed || rotary_shortest_path ||
-               rotary_degrees;
+               rotary_degrees || exact_stop;
     }
 };
 
@@ -76,6 +77,13 @@ struct SetFeedRate {
 };
 struct SetRapidRate {  // NcStudio: F in a G00 block; 0 = the machine's maximum
     double rapid_mm_s = 0;
+};
+// Path control mode (G61 / G64 [P]; PATH-9: an extension in NcStudio, which otherwise always
+// blends with the machine's tolerance). Sent each time a program writes G61 or G64, and at
+// program end when the mode was not the default. Applies to the moves that follow.
+struct SetBlending {
+    bool exact = false;        // G61: every move ends exactly at its end point (exact path)
+    double tolerance_mm = 0;   // G64 P: allowed deviation at a blend; <= 0 = the machine default
 };
 struct SetFeedMode {  // only feed per minute exists in NcStudio; kept for the ISO dialect
     bool per_minute = true;
@@ -188,7 +196,7 @@ using CanonCommand =
                  canon::SelectPlane, canon::Units, canon::SetOutput, canon::WaitInput, canon::Sync,
                  canon::ConditionalMove, canon::LatchConfig, canon::LatchClear,
                  canon::LatchStopDistance, canon::Message, canon::IntMessage, canon::HomeDone,
-                 canon::Stop, canon::Warning, canon::ProgramEnd>;
+                 canon::Stop, canon::Warning, canon::ProgramEnd, canon::SetBlending>;
 
 // One command with the block it came from. loc.file is owned by the interpreter (see SourceLoc).
 struct Canon {

@@ -39,6 +39,7 @@ class LinuxCncPrinter final : public CanonSink {
     void preamble();
     void flush_block();
     void print(const CanonCommand& c);
+    void exact_stop_note(const canon::MoveFlags& f);
     std::string axes(const AxisVec& machine) const;
     double unit(double mm) const { return mm / mm_per_unit_; }
 
@@ -79,6 +80,21 @@ class SummarySink final : public CanonSink {
     std::set<int> tools_;
     double feed_len_ = 0, rapid_len_ = 0, feed_time_ = 0;
     int moves_ = 0;
+};
+
+// Prints warnings as "file:line:col: warning: text", one per line: the front end's (as a
+// WarningSink) and the back end's canon::Warning commands (as a CanonSink; other commands are
+// ignored, so put it beside the real consumer with a TeeSink).
+class WarningPrinter final : public CanonSink, public WarningSink {
+  public:
+    explicit WarningPrinter(std::FILE* out) : out_(out) {}
+    void emit(const Canon& c) override;
+    void warning(const SourceLoc& loc, const std::string& text) override;
+    int count() const { return count_; }
+
+  private:
+    std::FILE* out_;
+    int count_ = 0;
 };
 
 // Fans one stream out to several sinks.

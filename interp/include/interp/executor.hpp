@@ -33,6 +33,9 @@ struct BackendConfig {
     bool end_stops_spindle = true;   // AUTOSTOPSPINDLE: M02/M30 stop spindle and coolant
     double max_rapid_mm_s = 0;       // clamp for F in G00 blocks; 0 = no clamp
     double max_feed_mm_s = 0;        // FEED-8: cutting feeds are clamped to this; 0 = no clamp
+    // MIR-5 (ISO): G28, G53, G54–G59, G92, G921, G922 and G992 are refused while an axis is
+    // mirrored. NcStudio's manual has no such rule, so it is off for the ncstudio dialects.
+    bool mirror_forbids_coord_changes = false;
     // The machine's default cutting feed, used by a feed move when no F was ever programmed
     // (NcStudio always has one; the manual's examples rely on it). 0 = such a move is an error.
     double default_feed_mm_s = 0;
@@ -51,6 +54,7 @@ struct BackendConfig {
 // Everything the executor keeps between blocks apart from settings and transforms.
 struct ExecState {
     MotionModal motion;
+    PathModal path;
     UnitsModal units;
     FeedModal feed;
     SpindleModal spindle;
@@ -66,6 +70,8 @@ struct ExecState {
     std::optional<int> crc_d;                   // last D word (selects the radius)
     CrcBlockState crc;     // what the compensator gets for this block (mirroring swaps the side)
     bool started = false;  // the initial offsets have been announced
+    // A move was emitted after the last Sync: reading the current point needs a sync first.
+    bool moved_since_sync = false;
 };
 
 class Executor final : public BlockExecutor, public MachineQuery {
@@ -85,6 +91,10 @@ class Executor final : public BlockExecutor, public MachineQuery {
     bool incremental_mode() override { return state_.motion.incremental; }
     bool cycle_return_to_r() override { return state_.cycle_return_to_r; }
     std::optional<double> setting(std::string_view name) override;
+    bool can_write_setting(std::string_view) override { return true; }
+    void write_setting(std::string_view name, double value) override {
+        set_persistent_param(name, value);
+    }
 
     // Called after every committed block that changed a persistent setting (for saving).
     void on_settings_changed(std::function<void(const Settings&)> fn) {

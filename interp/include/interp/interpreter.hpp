@@ -39,6 +39,8 @@ struct InterpreterOptions {
     // cfg:s_hook_prog (CUS-4 REC): a subprogram (in public.dat, else in the program) run after
     // every block with an S word, e.g. for gear changes. None by default.
     std::optional<std::int64_t> s_hook_program;
+    // Where the front end's warnings go (duplicate sequence numbers); none = not reported.
+    WarningSink* warnings = nullptr;
 };
 
 class Interpreter {
@@ -85,6 +87,7 @@ class Interpreter {
     void return_to_sequence(const ReturnRequest& r, const SourcePos& after_call);
     void push_calls(std::optional<CallFrame>& call_frame, const SourcePos& after_call);
     void end_program(const SourceLoc& loc);
+    void report_scan_warnings(const Source& src);
     // Starts (or repeats) a subprogram run: positions at the line after its label.
     void enter(CallFrame& frame);
     // Continues after a finished run: a queued run of the same block, or the caller.

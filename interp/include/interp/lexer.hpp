@@ -54,7 +54,7 @@ struct Token {
     Op op = Op::None;
     bool space_before = false;  // whitespace separates this token from the previous one
     bool has_point = false;     // Number written with a decimal point
-    int col = 0;                // 1-based byte column
+    int col = 0;                // 1-based column in characters (UTF-8 code points)
     std::string_view text;      // the token's characters (without quotes for String, '#' for Var)
     double number = 0.0;        // value of a Number
 };

@@ -17,6 +17,13 @@ struct MotionModal {
     bool incremental = false;  // G91
 };
 
+// G61 / G64 P (PATH-9). The default is NcStudio's: continuous with the machine's tolerance.
+struct PathModal {
+    bool exact = false;
+    double tolerance_mm = 0;  // <= 0: the machine default
+    bool operator==(const PathModal&) const = default;
+};
+
 struct UnitsModal {
     double mm_per_unit = 1.0;  // 25.4 under G20/G70
     bool inch() const { return mm_per_unit != 1.0; }

@@ -26,7 +26,8 @@ struct NamedParam {
     std::string_view name;  // canonical upper-case name, with axis suffix where it has one
     ParamKind kind;
     int index = 0;
-    bool length = false;  // value is a length or a linear speed: converted from mm
+    bool length = false;    // value is a length or a linear speed: converted from mm
+    bool writable = false;  // a program may assign it; the value persists (TSET-2)
 };
 
 // The 50 entries of S0 §4.1.2, in the manual's order.

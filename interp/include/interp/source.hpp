@@ -22,6 +22,14 @@ struct SourcePos {
     friend bool operator==(const SourcePos&, const SourcePos&) = default;
 };
 
+// A sequence number written twice in one program (main program or one subprogram). Allowed
+// (LEX-07), but M99 P / a search then finds the first one, which is rarely what was meant.
+struct DuplicateSequence {
+    std::int64_t n = 0;
+    int line = 0;
+    int col = 0;
+};
+
 // Where a subprogram label was defined: the label line itself.
 struct LabelSite {
     SourcePos pos;
@@ -56,11 +64,18 @@ class Source {
     std::optional<LabelSite> find_label(std::int64_t number) const;
     std::optional<LabelSite> find_label(std::string_view name) const;
     std::size_t label_count() const { return numbered_.size() + named_.size(); }
+    // Duplicate sequence numbers found by the same scan (the first kMaxDuplicates; N values
+    // of kMaxTrackedSequence and above are not tracked).
+    static constexpr std::size_t kMaxDuplicates = 100;
+    static constexpr std::int64_t kMaxTrackedSequence = std::int64_t{1} << 22;
+    const std::vector<DuplicateSequence>& duplicate_sequences() const { return duplicates_; }
 
   private:
     Source(std::string name, std::FILE* file, std::string text);
     void index_labels();
     void index_line(std::string_view line, SourcePos pos);
+    void index_sequence(std::string_view line, std::size_t at, int line_number);
+    void begin_sequence_scope();
     bool fill();
     // Discards the rest of a line longer than the limit, then throws Error naming it; reading
     // continues with the next line.
@@ -78,6 +93,12 @@ class Source {
     int cur_line_ = 0;
     std::map<std::int64_t, LabelSite> numbered_;
     std::map<std::string, LabelSite, std::less<>> named_;  // upper-cased names
+    // Sequence numbers of the current program scope during the scan: a bitmap (grown to the
+    // largest N seen, at most kMaxTrackedSequence bits = 512 KiB) and the words of it that were
+    // set, so the next label clears only those.
+    std::vector<std::uint64_t> seq_bits_;
+    std::vector<std::uint32_t> seq_touched_;
+    std::vector<DuplicateSequence> duplicates_;
 };
 
 }  // namespace interp

@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 #include "interp/block.hpp"
@@ -25,6 +26,17 @@ class Variables {
     double fixed_cycle(int n, const SourceLoc& loc) const;
     void set_fixed_cycle(int n, double v, const SourceLoc& loc);
 
+    // Writable named parameters (#FIXEDCALI_REC) assigned by the current block. They are held
+    // here until the block has executed, then handed to MachineQuery::write_setting by the
+    // interpreter; rollback() drops them. Values in mm for lengths.
+    struct NamedWrite {
+        std::string_view name;  // points into the static named-parameter table
+        double value = 0;
+    };
+    void set_named(std::string_view name, double value, const SourceLoc& loc);
+    std::optional<double> pending_named(std::string_view name) const;
+    const std::vector<NamedWrite>& pending_named_writes() const { return named_; }
+
     // Block transaction: writes after begin() are undone by rollback(), kept by commit().
     void begin();
     void commit();
@@ -44,6 +56,7 @@ class Variables {
     std::array<bool, kMaxNumbered + 1> numbered_set_{};
     std::array<double, kMaxFixedCycle + 1> fixed_cycle_{};
     std::vector<Undo> undo_;
+    std::vector<NamedWrite> named_;
     bool in_block_ = false;
 };
 

@@ -397,6 +397,10 @@ void BlockRun::program_end(bool rewind) {
     st.coord.g992_active = false;
     st.motion = MotionModal{};
     st.units = UnitsModal{};
+    if (!(st.path == PathModal{})) {
+        st.path = PathModal{};
+        emit(canon::SetBlending{false, 0});
+    }
     st.feed.rapid_mm_s = 0;
     st.tool.length_mode = ToolLengthMode::Off;
     st.tool.h_register.reset();

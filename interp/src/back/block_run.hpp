@@ -27,6 +27,7 @@ enum class GGroup {
     Cycle,        // G73 … G89, G80
     CycleReturn,  // G98 / G99
     Crc,          // G40 / G41 / G42
+    PathMode,     // G61 / G64
     Flag,
 };
 
@@ -94,6 +95,7 @@ class BlockRun {
     void step_cutter_comp();
     void step_crc_effective();
     void step_wcs();
+    void step_path_mode();
     void step_distance();
     void step_transforms();
     void step_settings_writes();
@@ -122,6 +124,13 @@ class BlockRun {
     bool m(int code) const { return b_.has_m(code); }
     template <typename T>
     void emit(T&& cmd) {
+        using C = std::decay_t<T>;
+        if constexpr (std::is_same_v<C, canon::Sync>)
+            st.moved_since_sync = false;
+        else if constexpr (std::is_same_v<C, canon::Traverse> ||
+                           std::is_same_v<C, canon::FeedLine> || std::is_same_v<C, canon::Arc> ||
+                           std::is_same_v<C, canon::ConditionalMove>)
+            st.moved_since_sync = true;
         out_.push_back(Canon{b_.loc, CanonCommand(std::forward<T>(cmd))});
     }
     const ProgramTransform& xf() const { return xf_copy ? *xf_copy : base_xf_; }
@@ -162,6 +171,7 @@ class BlockRun {
     void update_tool_offset(const SourceLoc& loc);
     AxisVec programmed_target() const;
     void require_no_scaling(int code) const;
+    void require_no_mirror_coord_change() const;
     void require_feed(const char* what);
 
     void emit_rapid(const AxisVec& end);

@@ -263,10 +263,57 @@ void BlockRun::step_wcs() {
     }
 }
 
+// G61 / G64 [P] (PATH-2, PATH-3, PATH-9). Announced every time one is written, as LinuxCNC does,
+// so a consumer needs no state to follow it. P belongs to G64 here, so another user of P in the
+// same block would make it ambiguous.
+void BlockRun::step_path_mode() {
+    if (!group(GGroup::PathMode)) return;
+    if (g(gcode(61))) {
+        st.path = PathModal{true, 0};
+        emit(canon::SetBlending{true, 0});
+        return;
+    }
+    double tol_mm = 0;
+    if (b_.has('P')) {
+        static constexpr int kOtherPUsers[] = {gcode(4),   gcode(51),  gcode(922), gcode(923),
+                                               gcode(906), gcode(34),  gcode(35),  gcode(36),
+                                               gcode(37)};
+        const bool cycle_block = (cycle_code_ && *cycle_code_ != gcode(80)) ||
+                                 (st.cycle.active() && !motion_code_ && any_axis_word());
+        if (cycle_block)
+            fail(b_.loc_of('P'), "G64 in a canned-cycle block: P is ambiguous");
+        for (int other : kOtherPUsers)
+            if (g(other))
+                fail(b_.loc_of('P'), fmt::format("G64 and {} in one block: P is ambiguous",
+                                                 gname(other)));
+        for (int other : {802, 901, 903})
+            if (m(other))
+                fail(b_.loc_of('P'), fmt::format("G64 and {} in one block: P is ambiguous",
+                                                 mname(other)));
+        tol_mm = mm('P');
+        if (tol_mm < 0)
+            fail(b_.loc_of('P'),
+                 fmt::format("G64: negative blend tolerance P{}", fmt_num(b_.get('P'))));
+    }
+    st.path = PathModal{false, tol_mm};
+    emit(canon::SetBlending{false, tol_mm});
+}
+
 void BlockRun::step_distance() {
     if (!group(GGroup::Distance)) return;
     if (g(gcode(90))) st.motion.incremental = false;
     if (g(gcode(91))) st.motion.incremental = true;
+}
+
+void BlockRun::require_no_mirror_coord_change() const {
+    if (!cfg_.mirror_forbids_coord_changes || !xf().mirror_active()) return;
+    static constexpr int kCoordCodes[] = {gcode(28), gcode(53),  gcode(54),  gcode(55),
+                                          gcode(56), gcode(57),  gcode(58),  gcode(59),
+                                          gcode(92), gcode(921), gcode(922), gcode(992)};
+    for (int code : kCoordCodes)
+        if (g(code))
+            fail(loc_g(code),
+                 fmt::format("{} is not allowed while mirroring (G51.1) is active", gname(code)));
 }
 
 void BlockRun::require_no_scaling(int code) const {
@@ -423,11 +470,15 @@ void BlockRun::write_g923() {
     update_tool_offset(loc);
 }
 
+// G992-3 REC: the manual's array examples put G906 before every G992 so that the interpreter
+// knows where the machine really is; G992 syncs by itself unless nothing has moved since the last
+// sync (so a program written the manual's way gets no second sync).
 void BlockRun::write_g992() {
     const SourceLoc loc = loc_g(gcode(992));
     const bool ijk = b_.has('I') || b_.has('J') || b_.has('K');
     if (ijk && any_axis_word()) fail(loc, "G992: use either X Y Z or I J K, not both");
     if (!ijk && !any_axis_word()) fail(loc, "G992 needs X Y Z or I J K");
+    if (st.moved_since_sync) emit(canon::Sync{});
     if (ijk) {
         if (cfg_.v54_compat) fail(loc, "G992 I J K is not available in NcStudio V5.4");
         for (int a = 0; a < 3; ++a)

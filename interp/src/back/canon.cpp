@@ -38,6 +38,7 @@ std::string flags_text(const canon::MoveFlags& f) {
     if (f.force_programmed_feed) s += " programmed-feed";
     if (f.rotary_shortest_path) s += " rotary-shortest";
     if (f.rotary_degrees) s += " rotary-degrees";
+    if (f.exact_stop) s += " exact-stop";
     return s;
 }
 
@@ -67,6 +68,11 @@ struct TextVisitor {
     }
     std::string operator()(const canon::SetRapidRate& c) const {
         return fmt::format("rapid-rate {}mm/s", fmt_num(c.rapid_mm_s));
+    }
+    std::string operator()(const canon::SetBlending& c) const {
+        if (c.exact) return "blending exact";
+        if (c.tolerance_mm <= 0) return "blending continuous tolerance=default";
+        return fmt::format("blending continuous tolerance={}mm", fmt_num(c.tolerance_mm));
     }
     std::string operator()(const canon::SetFeedMode& c) const {
         return c.per_minute ? "feed-mode per-minute" : "feed-mode inverse-time";

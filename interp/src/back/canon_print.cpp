@@ -90,7 +90,7 @@ void LinuxCncPrinter::flush_block() {
         const CanonCommand& c = block_[i];
         if (ends && i >= last_move &&
             (is<canon::Spindle>(c) || is<canon::Coolant>(c) || is<canon::Offsets>(c) ||
-             is<canon::ToolOffset>(c))) {
+             is<canon::ToolOffset>(c) || is<canon::SetBlending>(c))) {
             if (is<canon::Offsets>(c)) offsets_ = std::get<canon::Offsets>(c);
             continue;
         }
@@ -133,8 +133,19 @@ void LinuxCncPrinter::print(const CanonCommand& cmd) {
             using T = std::decay_t<decltype(c)>;
             if constexpr (std::is_same_v<T, canon::Traverse>) {
                 line("STRAIGHT_TRAVERSE(" + move_args(c.end_mm) + ")");
+                exact_stop_note(c.flags);
             } else if constexpr (std::is_same_v<T, canon::FeedLine>) {
                 line("STRAIGHT_FEED(" + move_args(c.end_mm) + ")");
+                exact_stop_note(c.flags);
+            } else if constexpr (std::is_same_v<T, canon::SetBlending>) {
+                // rs274 prints the tolerance in program units; P0 and no P both print 0.
+                if (c.exact) {
+                    line("SET_MOTION_CONTROL_MODE(CANON_EXACT_PATH)");
+                } else {
+                    const double tol = c.tolerance_mm > 0 ? unit(c.tolerance_mm) : 0.0;
+                    line(fmt::format("SET_MOTION_CONTROL_MODE(CANON_CONTINUOUS, {:.6f})", tol));
+                    line(fmt::format("SET_NAIVECAM_TOLERANCE({})", f4(tol)));
+                }
             } else if constexpr (std::is_same_v<T, canon::Arc>) {
                 const PlaneAxes pa = plane_axes(c.plane);
                 const AxisVec e = work(c.end_mm);
@@ -144,6 +155,7 @@ void LinuxCncPrinter::print(const CanonCommand& cmd) {
                 line(fmt::format("ARC_FEED({}, {}, {}, {}, {}, {}, {}, {}, {})", f4(e[pa.first]),
                                  f4(e[pa.second]), f4(cw[pa.first]), f4(cw[pa.second]), c.turns,
                                  f4(e[pa.normal]), f4(e[3]), f4(e[4]), f4(e[5])));
+                exact_stop_note(c.flags);
             } else if constexpr (std::is_same_v<T, canon::SetFeedRate>) {
                 line(fmt::format("SET_FEED_RATE({})", f4(unit(c.feed_mm_s * 60))));
             } else if constexpr (std::is_same_v<T, canon::Dwell>) {
@@ -203,11 +215,27 @@ void LinuxCncPrinter::print(const CanonCommand& cmd) {
         cmd);
 }
 
+// LinuxCNC has no G09; the stop is kept visible rather than dropped.
+void LinuxCncPrinter::exact_stop_note(const canon::MoveFlags& f) {
+    if (f.exact_stop) line("COMMENT(\"native: exact-stop\")");
+}
+
 void LinuxCncPrinter::finish() {
     flush_block();
     if (!started_) preamble();
     line("ON_RESET()");
     line("ON_RESET()");
+}
+
+// ---------------------------------------------------------------------------------------------
+
+void WarningPrinter::emit(const Canon& c) {
+    if (const auto* w = std::get_if<canon::Warning>(&c.cmd)) warning(c.loc, w->text);
+}
+
+void WarningPrinter::warning(const SourceLoc& loc, const std::string& text) {
+    ++count_;
+    fmt::print(out_, "{}:{}:{}: warning: {}\n", loc.file, loc.line, loc.col, text);
 }
 
 // ---------------------------------------------------------------------------------------------

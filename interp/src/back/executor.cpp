@@ -50,6 +50,8 @@ constexpr GInfo kGTable[] = {
     {gcode(918), GGroup::NonModal, false},   {gcode(919), GGroup::NonModal, false},
     {gcode(921), GGroup::NonModal, true},    {gcode(922), GGroup::NonModal, true},
     {gcode(923), GGroup::NonModal, true},    {gcode(992), GGroup::NonModal, true},
+    {gcode(9), GGroup::Flag, false},         {gcode(61), GGroup::PathMode, false},
+    {gcode(64), GGroup::PathMode, false},
 };
 
 const GInfo* find_g(int code) {
@@ -90,7 +92,7 @@ const BlockRun::Step BlockRun::kSteps[] = {
     &BlockRun::step_spindle,       &BlockRun::step_coolant,       &BlockRun::step_io,
     &BlockRun::step_dwell,         &BlockRun::step_plane,         &BlockRun::announce_units,
     &BlockRun::step_cutter_comp,   &BlockRun::step_tool_length,   &BlockRun::step_wcs,
-    &BlockRun::step_distance,      &BlockRun::step_transforms,    &BlockRun::step_settings_writes,
+    &BlockRun::step_path_mode,     &BlockRun::step_distance,      &BlockRun::step_transforms,    &BlockRun::step_settings_writes,
     &BlockRun::step_machine_codes, &BlockRun::step_cycle_modes,   &BlockRun::step_motion,
     &BlockRun::step_stop,          &BlockRun::step_crc_effective,
 };
@@ -103,7 +105,7 @@ void BlockRun::run() {
 // Validation: unknown codes, two codes of one modal group, G90 with G91 (ABS-2).
 
 void BlockRun::validate() {
-    std::array<int, 16> seen_group;
+    std::array<int, static_cast<int>(GGroup::Flag) + 1> seen_group;
     seen_group.fill(-1);
     for (std::size_t i = 0; i < b_.g.size(); ++i) {
         const int code = b_.g[i];
@@ -155,6 +157,8 @@ void BlockRun::validate() {
     flags_.force_programmed_feed = g(gcode(905));
     flags_.rotary_shortest_path = g(gcode(907));
     flags_.rotary_degrees = g(gcode(908));
+    flags_.exact_stop = g(gcode(9));
+    require_no_mirror_coord_change();
 }
 
 // The first block announces where the offsets stand, so a consumer that needs work coordinates

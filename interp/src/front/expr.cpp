@@ -132,6 +132,9 @@ double ExprEvaluator::read(const Token& var) {
             return vars_.fixed_cycle(ref.index, loc(var));
         case VarRef::Kind::Named: {
             const auto p = find_named_param(ref.text, d_);
+            // A value this block wrote is read back before it reaches the machine.
+            if (auto v = vars_.pending_named(p->name))
+                return p->length ? *v / machine_.mm_per_program_unit() : *v;
             return read_named_param(*p, machine_, loc(var));
         }
     }

@@ -77,11 +77,22 @@ Interpreter::Interpreter(BlockExecutor& executor, MachineQuery& machine, Interpr
 Interpreter::~Interpreter() = default;
 
 void Interpreter::load_library(const std::string& path) {
-    library_ = Source::open_file(path);
+    set_library(Source::open_file(path));
 }
 
 void Interpreter::set_library(std::unique_ptr<Source> library) {
     library_ = std::move(library);
+    report_scan_warnings(*library_);
+}
+
+// LEX-07 allows a sequence number twice, but an M99 P search then stops at the first one.
+void Interpreter::report_scan_warnings(const Source& src) {
+    if (options_.warnings == nullptr) return;
+    for (const DuplicateSequence& d : src.duplicate_sequences())
+        options_.warnings->warning(
+            SourceLoc{src.name(), d.line, d.col},
+            "sequence number N" + std::to_string(d.n) +
+                " is used twice in this program; M99 P and searches find the first one");
 }
 
 void Interpreter::open(const std::string& path, const Dialect* dialect) {
@@ -94,6 +105,7 @@ void Interpreter::open(std::unique_ptr<Source> program, const Dialect* dialect) 
         parser_.set_dialect(*dialect);
     }
     main_ = std::move(program);
+    report_scan_warnings(*main_);
     current_ = main_.get();
     stack_.clear();
     vars_.clear();
@@ -126,6 +138,8 @@ bool Interpreter::step() {
     try {
         parser_.parse(line, loc, parsed_);
         execute_line(parsed_.block.loc);
+        for (const Variables::NamedWrite& w : vars_.pending_named_writes())
+            machine_.write_setting(w.name, w.value);
         vars_.commit();
     } catch (...) {
         vars_.rollback();

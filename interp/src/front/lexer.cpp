@@ -191,8 +191,16 @@ void Lexer::lex(std::string_view s, const SourceLoc& loc, std::vector<Token>& ou
     std::size_t i = 0;
     int depth = 0;
     bool space = false;
+    // Columns count characters (UTF-8 code points), not bytes: `cont` is the number of UTF-8
+    // continuation bytes before i. Non-ASCII text can only be skipped inside a ( ) comment or a
+    // string, so only those two places count them, and ASCII lines pay nothing.
+    int cont = 0;
+    auto count_cont = [&](std::size_t from, std::size_t to) {
+        for (std::size_t k = from; k < to && k < s.size(); ++k)
+            cont += (static_cast<unsigned char>(s[k]) & 0xC0) == 0x80;
+    };
     auto error = [&](std::size_t at, const std::string& msg) {
-        throw Error(SourceLoc{loc.file, loc.line, static_cast<int>(at) + 1}, msg);
+        throw Error(SourceLoc{loc.file, loc.line, static_cast<int>(at) + 1 - cont}, msg);
     };
     while (i < s.size()) {
         const char c = s[i];
@@ -211,7 +219,7 @@ void Lexer::lex(std::string_view s, const SourceLoc& loc, std::vector<Token>& ou
             break;
         // Built in place: copying a finished Token into the vector stalls on store forwarding.
         Token& tok = out.emplace_back();
-        tok.col = static_cast<int>(i) + 1;
+        tok.col = static_cast<int>(i) + 1 - cont;
         tok.space_before = space;
         space = false;
         if (is_alpha(c)) {
@@ -250,7 +258,9 @@ void Lexer::lex(std::string_view s, const SourceLoc& loc, std::vector<Token>& ou
             if (j >= s.size()) error(i, "unterminated string (missing closing quote)");
             tok.kind = Tok::String;
             tok.text = s.substr(i + q, j - i - q);
+            const std::size_t start = i;
             i = j + quote_length(s.substr(j));
+            count_cont(start, i);
         } else if (c == '(' &&
                    !paren_is_expression(out.size() >= 2 ? &out[out.size() - 2] : nullptr, depth,
                                         expression_start)) {
@@ -263,6 +273,7 @@ void Lexer::lex(std::string_view s, const SourceLoc& loc, std::vector<Token>& ou
                 if (s[j] == ')' && --nest == 0) break;
             }
             if (j >= s.size()) error(i, "unclosed '(' comment");
+            count_cont(i, j + 1);
             i = j + 1;
             space = true;
             continue;
@@ -279,7 +290,7 @@ void Lexer::lex(std::string_view s, const SourceLoc& loc, std::vector<Token>& ou
         }
     }
     Token& end = out.emplace_back();
-    end.col = static_cast<int>(i) + 1;
+    end.col = static_cast<int>(i) + 1 - cont;
     end.space_before = true;
 }
 

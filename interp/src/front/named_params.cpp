@@ -12,7 +12,9 @@ namespace {
 using K = ParamKind;
 constexpr int X = 0, Y = 1, Z = 2;
 
-// S0 §4.1.2, entries 01–50. `length` marks values the manual gives in mm or mm/min.
+// S0 §4.1.2, entries 01–50. `length` marks values the manual gives in mm or mm/min. Only
+// FIXEDCALI_REC is written by programs: the fixed tool-setting routine records the contact Z in it
+// (TSET-2); every other entry is a machine setting, read-only to programs (VAR-03).
 constexpr std::array<NamedParam, 50> kNcStudioParams{{
     {"CURMACHPOS.X", K::MachinePos, X, true},     {"CURMACHPOS.Y", K::MachinePos, Y, true},
     {"CURMACHPOS.Z", K::MachinePos, Z, true},     {"CURWORKPOS.X", K::WorkPos, X, true},
@@ -38,7 +40,7 @@ constexpr std::array<NamedParam, 50> kNcStudioParams{{
     {"BKREF_BACK.Z", K::Setting, 0, true},        {"CALIBRATION_SW", K::Setting, 0, false},
     {"SPINDLE_START_PORT", K::Setting, 0, false}, {"COOLANT_START_PORT", K::Setting, 0, false},
     {"DD_BKREF_DELTA", K::Setting, 0, true},      {"FIXEDCYCLE_BACK", K::Setting, 0, true},
-    {"FIXEDCYCLE_OSS", K::Setting, 0, false},     {"FIXEDCALI_REC", K::Setting, 0, true},
+    {"FIXEDCYCLE_OSS", K::Setting, 0, false},     {"FIXEDCALI_REC", K::Setting, 0, true, true},
 }};
 
 // "CTP_POS. x" -> "CTP_POS.X"

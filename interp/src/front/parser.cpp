@@ -305,14 +305,23 @@ void BlockParser::parse_assignment(Ctx& c, const Token& var) {
                                    " on its own is not a word (did you mean #" +
                                    std::string(var.text) + "=…?)");
     }
+    std::optional<NamedParam> named;
     if (ref.kind == VarRef::Kind::Named) {
-        throw Error(c.at(var), "named parameter #" + std::string(var.text) + " is read-only");
+        named = find_named_param(var.text, *dialect_);
+        if (!named || !named->writable)
+            throw Error(c.at(var), "named parameter #" + std::string(var.text) + " is read-only");
     }
     const Token& e = c.cur.peek();
     if (e.kind == Tok::End) throw Error(c.at(e), "expression expected after '='");
     const double v = c.eval.evaluate(c.cur, c.dry);
     if (c.dry) return;
-    if (ref.kind == VarRef::Kind::Numbered) {
+    if (named) {
+        if (!machine_.can_write_setting(named->name))
+            throw Error(c.at(var), "named parameter #" + std::string(named->name) +
+                                       " cannot be stored on this machine (no settings file)");
+        const double to_mm = named->length ? machine_.mm_per_program_unit() : 1.0;
+        vars_.set_named(named->name, v * to_mm, c.at(var));
+    } else if (ref.kind == VarRef::Kind::Numbered) {
         vars_.set_numbered(ref.index, v, c.at(var));
     } else {
         vars_.set_fixed_cycle(ref.index, v, c.at(var));

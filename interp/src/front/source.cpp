@@ -114,10 +114,46 @@ void Source::seek(const SourcePos& pos) {
     cur_line_offset_ = pos.offset;
 }
 
+// Records N at `at` in the current program scope; a second N of the same value is a duplicate.
+void Source::index_sequence(std::string_view line, std::size_t at, int line_number) {
+    std::size_t i = at + 1;
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+    if (i >= line.size() || !is_digit(line[i])) return;
+    std::int64_t n = 0;
+    while (i < line.size() && is_digit(line[i])) {
+        n = n * 10 + (line[i] - '0');
+        if (n >= kMaxTrackedSequence) return;
+        ++i;
+    }
+    const std::size_t word = static_cast<std::size_t>(n) / 64;
+    const std::uint64_t bit = std::uint64_t{1} << (n % 64);
+    if (word >= seq_bits_.size()) seq_bits_.resize(word + 1);
+    if (seq_bits_[word] & bit) {
+        if (duplicates_.size() < kMaxDuplicates)
+            duplicates_.push_back({n, line_number, static_cast<int>(at) + 1});
+        return;
+    }
+    if (seq_bits_[word] == 0) seq_touched_.push_back(static_cast<std::uint32_t>(word));
+    seq_bits_[word] |= bit;
+}
+
+void Source::begin_sequence_scope() {
+    for (std::uint32_t w : seq_touched_) seq_bits_[w] = 0;
+    seq_touched_.clear();
+}
+
 void Source::index_line(std::string_view line, SourcePos pos) {
     std::size_t i = 0;
     while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+    std::size_t n_at = i;  // a block-delete '/' may stand before N
+    while (n_at < line.size() && (line[n_at] == ' ' || line[n_at] == '\t' || line[n_at] == '/'))
+        ++n_at;
+    if (n_at < line.size() && (line[n_at] == 'N' || line[n_at] == 'n')) {
+        index_sequence(line, n_at, pos.line);
+        return;
+    }
     if (i >= line.size() || (line[i] != 'O' && line[i] != 'o')) return;
+    begin_sequence_scope();
     const int col = static_cast<int>(i) + 1;
     ++i;
     const LabelSite site{pos, col};
@@ -161,6 +197,9 @@ void Source::index_labels() {
         }
         index_line(line, line_start());
     }
+    // The scan's bookkeeping is not needed while the program runs.
+    seq_bits_ = {};
+    seq_touched_ = {};
     seek(SourcePos{});
 }
 

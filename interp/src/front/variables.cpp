@@ -57,13 +57,31 @@ void Variables::set_fixed_cycle(int n, double v, const SourceLoc& loc) {
     fixed_cycle_[n] = v;
 }
 
+void Variables::set_named(std::string_view name, double v, const SourceLoc& loc) {
+    check_finite(v, "#" + std::string(name), loc);
+    for (NamedWrite& w : named_)
+        if (w.name == name) {
+            w.value = v;
+            return;
+        }
+    named_.push_back(NamedWrite{name, v});
+}
+
+std::optional<double> Variables::pending_named(std::string_view name) const {
+    for (const NamedWrite& w : named_)
+        if (w.name == name) return w.value;
+    return std::nullopt;
+}
+
 void Variables::begin() {
     undo_.clear();
+    named_.clear();
     in_block_ = true;
 }
 
 void Variables::commit() {
     undo_.clear();
+    named_.clear();
     in_block_ = false;
 }
 
@@ -78,6 +96,7 @@ void Variables::rollback() {
         }
     }
     undo_.clear();
+    named_.clear();
     in_block_ = false;
 }
 
@@ -86,6 +105,7 @@ void Variables::clear() {
     numbered_set_.fill(false);
     fixed_cycle_.fill(0.0);
     undo_.clear();
+    named_.clear();
     in_block_ = false;
 }
 

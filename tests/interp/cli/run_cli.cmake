@@ -20,6 +20,7 @@ endfunction()
 
 expect_run(bad 1)
 expect_run(good 0)
+expect_run(warn 0)
 
 # --settings with --save-settings: G92 and G923 are written back (atomically) and survive.
 file(MAKE_DIRECTORY ${WORK})
