@@ -27,12 +27,13 @@ constexpr std::size_t kMaxGroupItems = 256;
 constexpr double kMaxArcBlendSin = 1.35;
 // Share of an arc a corner blend may take (less than half: an arc never vanishes).
 constexpr double kMaxArcTrimShare = 0.45;
-// Checking a blend with an arc: the blend is sampled at kDeviationSamples points against the
-// programmed moves' last and first kDeviationReach * l as kDeviationChords chords each; the
-// result must be within kDeviationMargin of the tolerance (the samples may miss the peak by a
-// little), else l shrinks by 0.7, at most kBlendAttempts times.
-constexpr int kDeviationSamples = 16;
-constexpr int kDeviationChords = 16;
+// Checking a blend with an arc: the blend is sampled at kDeviationSamples points (the largest
+// refined in kDeviationRefine golden-section steps) against the programmed moves' last and first
+// kDeviationReach * l as kDeviationChords chords each; the result must be within
+// kDeviationMargin of the tolerance, else l shrinks by 0.7, at most kBlendAttempts times.
+constexpr int kDeviationSamples = 48;
+constexpr int kDeviationChords = 32;
+constexpr int kDeviationRefine = 16;
 constexpr double kDeviationReach = 2;
 constexpr double kDeviationMargin = 0.95;
 constexpr int kBlendAttempts = 12;
@@ -257,16 +258,35 @@ double chain_dist2(const AxisArray& q, const Chords& c) {
 }
 
 // Largest distance of the blend from the two programmed moves near their corner (an upper
-// bound: only the parts near the corner are searched, and arcs are taken as chords plus their
-// bulge).
-double blend_deviation_mm(const Element& blend, const Chords& before, const Chords& after) {
+// bound up to the sampling: only the parts near the corner are searched, arcs are taken as
+// chords plus their bulge, and the largest of the samples is refined by a golden-section search
+// between its neighbours).
+// Stops early, returning a value above `limit_mm`, once a sample is beyond it.
+double blend_deviation_mm(const Element& blend, const Chords& before, const Chords& after,
+                          double limit_mm) {
+    const double bulge = std::max(before.sagitta_mm, after.sagitta_mm);
+    const double limit2 = limit_mm > bulge ? (limit_mm - bulge) * (limit_mm - bulge) : 0.0;
+    auto dist2_at = [&](double u) {
+        CurvePoint cp;
+        evaluate(blend, blend.length_mm * u, cp);
+        return std::min(chain_dist2(cp.p, before), chain_dist2(cp.p, after));
+    };
     double worst = 0;
-    CurvePoint cp;
+    int at = 1;
     for (int i = 1; i < kDeviationSamples; ++i) {
-        evaluate(blend, blend.length_mm * i / kDeviationSamples, cp);
-        worst = std::max(worst, std::min(chain_dist2(cp.p, before), chain_dist2(cp.p, after)));
+        double d = dist2_at(double(i) / kDeviationSamples);
+        if (d > limit2) return std::sqrt(d) + bulge;
+        if (d > worst) worst = d, at = i;
     }
-    return std::sqrt(worst) + std::max(before.sagitta_mm, after.sagitta_mm);
+    const double g = (std::sqrt(5.0) - 1) / 2;
+    double lo = double(at - 1) / kDeviationSamples, hi = double(at + 1) / kDeviationSamples;
+    for (int it = 0; it < kDeviationRefine; ++it) {
+        double m1 = hi - g * (hi - lo), m2 = lo + g * (hi - lo);
+        double d1 = dist2_at(m1), d2 = dist2_at(m2);
+        worst = std::max({worst, d1, d2});
+        (d1 < d2 ? lo : hi) = d1 < d2 ? m1 : m2;
+    }
+    return std::sqrt(worst) + bulge;
 }
 
 // Distance h of a Bezier blend's inner control points from its ends p0, p3 along the unit
@@ -319,7 +339,8 @@ Planner::Junction Planner::bezier_corner(const Piece& p, const Piece& next, doub
         }
         Junction jn{kInf, false, l, Blend::Curve};
         jn.curve = make_bezier(a.p, c1, c2, b.p);
-        if (blend_deviation_mm(jn.curve, before, after) > kDeviationMargin * tol) continue;
+        const double allowed_mm = kDeviationMargin * tol;
+        if (blend_deviation_mm(jn.curve, before, after, allowed_mm) > allowed_mm) continue;
         jn.curve_end_cap_mm_s = kInf;
         if (!jerk_mode_) return jn;  // without a jerk limit curvature steps cost nothing
         EndDerivs bs = start_derivs(jn.curve), be = end_derivs(jn.curve);

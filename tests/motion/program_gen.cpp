@@ -135,6 +135,17 @@ Program random_program(std::mt19937_64& rng, const GenOptions& opt) {
     if (g.u(rng) < 0.5) g.dir = normalized({g.dir[0], g.dir[1], 0});
     while (int(g.prog.segs.size()) < opt.count) {
         double r = g.u(rng);
+        if (opt.arc_corners) {
+            if (r < 0.3)
+                g.line(false);
+            else
+                g.arc();
+            static const double tols[] = {0.002, 0.01, 0.05, 0.5};
+            PathSegment& s = g.prog.segs.back();
+            s.tolerance_mm = tols[std::uniform_int_distribution<int>(0, 3)(rng)];
+            s.exact_stop = false;
+            continue;
+        }
         if (r < 0.55)
             g.line(opt.rotary);
         else if (r < 0.85)

@@ -22,6 +22,9 @@ struct Program {
 struct GenOptions {
     int count = 40;
     bool rotary = true;  // sometimes move A too
+    // Mostly arcs (and some lines) meeting at kinks, each corner with a tolerance > 0 and no
+    // exact stops: the corners with arcs that the planner blends.
+    bool arc_corners = false;
 };
 
 Program random_program(std::mt19937_64& rng, const GenOptions& opt);

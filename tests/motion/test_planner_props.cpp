@@ -140,6 +140,22 @@ TEST(RandomProgramsPlanOnly, StreamingWithJerkNeverPlansARampLongerThanItsElemen
     }
 }
 
+// Corners with arcs (blended by Bezier curves): mostly arcs and helices meeting lines and each
+// other at random angles, every corner with a tolerance. Odd seeds are jerk-limited, with high
+// limits (1e6 .. 1e8 mm/s^3) under which the blends' curvature steps are allowed.
+TEST_P(RandomPrograms, ArcCornersStayWithinLimitsAndToleranceAndEndExactly) {
+    const std::uint64_t seed = GetParam();
+    const bool jerk = seed % 2 == 1;
+    std::mt19937_64 rng(seed * 7919 + jerk);
+    GenOptions opt;
+    opt.count = 12;
+    opt.arc_corners = true;
+    Program prog = random_program(rng, opt);
+    PlannerConfig cfg = config(rng, jerk, seed % 4 < 2 ? 4096 : 6);
+    for (double& j : cfg.limits.jerk_mm_s3) j *= 100;
+    expect_clean_finish(play(cfg, prog, nullptr, {}), prog, seed);
+}
+
 INSTANTIATE_TEST_SUITE_P(Seeds, RandomPrograms, ::testing::Range<std::uint64_t>(1, 31));
 
 }  // namespace
