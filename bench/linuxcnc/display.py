@@ -80,13 +80,19 @@ class Bench:
         self.cmd.auto(linuxcnc.AUTO_RUN, 0)
         self.wait_for("the program to start",
                       lambda s: s.interp_state != linuxcnc.INTERP_IDLE or s.queue > 0)
-        # Poll at 1 ms; only wall_s depends on it (to +-1 ms), motion_s comes from HAL.
+        # Poll at 1 ms; only wall_s depends on it (to +-1 ms), motion_s comes from HAL. The
+        # task can look idle and in position for a moment before motion has started (seen on
+        # short programs: a run that counted nothing), so the end also needs a counted motion.
         self.wait_for("the program to end",
                       lambda s: s.interp_state == linuxcnc.INTERP_IDLE and s.queue == 0
-                      and s.inpos, timeout_s=3600)
+                      and s.inpos and int(halcmd("getp", "bench-runs.count")) > 0,
+                      timeout_s=3600)
         wall_s = time.monotonic() - start
+        motion_s = halcmd("getp", "bench-time.out")
+        if float(motion_s) <= 0:
+            raise RuntimeError("the program ended without a counted motion")
         return {
-            "motion_s": halcmd("getp", "bench-time.out"),
+            "motion_s": motion_s,
             "runs": halcmd("getp", "bench-runs.count"),
             "wall_s": f"{wall_s:.4f}",
         }
