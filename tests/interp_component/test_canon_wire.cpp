@@ -26,6 +26,7 @@ std::vector<CanonCommand> samples() {
     canon::MoveFlags flags;
     flags.force_full_override = true;
     flags.rotary_degrees = true;
+    flags.exact_stop = true;
     const interp::AxisVec end{1.25, -2.5, 3.0625, 45, -90, 180.5};
     canon::Arc arc;
     arc.plane = interp::Plane::ZX;
@@ -73,6 +74,8 @@ std::vector<CanonCommand> samples() {
         canon::Stop{true},
         canon::Warning{"M10 in the 6th edition is a spindle clamp"},
         canon::ProgramEnd{true},
+        canon::SetBlending{false, 0.0375},
+        canon::SetBlending{true, 0},
     };
 }
 

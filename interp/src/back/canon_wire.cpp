@@ -3,16 +3,11 @@
 #include <fmt/format.h>
 
 #include <bit>
-#include <concepts>
 #include <cstring>
 #include <optional>
 #include <type_traits>
 #include <utility>
 #include <variant>
-
-namespace interp::canon {
-struct SetBlending;  // G61/G64 (being added to canon.hpp); declared here so this file builds either way
-}
 
 namespace interp::wire {
 
@@ -27,15 +22,10 @@ constexpr std::size_t kTextBytesPerRecord = (kWireFields - 1) * sizeof(std::uint
 // The fields of every command, in wire order. One function per type serves both directions:
 // the archive either writes the listed members or reads them back.
 
-// G09's flag (being added to MoveFlags): sent when the build has it.
-template <class A, class Flags>
-void exact_stop_field(A& a, Flags& f) {
-    if constexpr (requires { f.exact_stop; }) a(f.exact_stop);
-}
 template <class A>
 void fields(A& a, canon::MoveFlags& f) {
-    a(f.force_full_override, f.force_programmed_feed, f.rotary_shortest_path, f.rotary_degrees);
-    exact_stop_field(a, f);
+    a(f.force_full_override, f.force_programmed_feed, f.rotary_shortest_path, f.rotary_degrees,
+      f.exact_stop);
 }
 template <class A>
 void fields(A& a, canon::Traverse& c) {
@@ -161,9 +151,8 @@ template <class A>
 void fields(A& a, canon::ProgramEnd& c) {
     a(c.rewind);
 }
-template <class A, class B>
-    requires std::same_as<B, canon::SetBlending>
-void fields(A& a, B& c) {
+template <class A>
+void fields(A& a, canon::SetBlending& c) {
     a(c.exact, c.tolerance_mm);
 }
 
