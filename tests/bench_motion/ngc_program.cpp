@@ -25,7 +25,7 @@ AxisArray to_axes(const interp::AxisVec& v) {
 class SegmentSink final : public interp::CanonSink {
   public:
     SegmentSink(BenchProgram& prog, double tolerance_mm)
-        : prog_(prog), tolerance_mm_(tolerance_mm) {}
+        : prog_(prog), default_tolerance_mm_(tolerance_mm), tolerance_mm_(tolerance_mm) {}
 
     void emit(const interp::Canon& c) override {
         std::visit([&](const auto& cmd) { handle(c.loc, cmd); }, c.cmd);
@@ -33,17 +33,17 @@ class SegmentSink final : public interp::CanonSink {
 
   private:
     void handle(const interp::SourceLoc& loc, const interp::canon::Traverse& t) {
-        PathSegment seg = base(loc, t.end_mm);
+        PathSegment seg = base(loc, t.end_mm, t.flags);
         seg.rapid = true;
         add(seg);
     }
     void handle(const interp::SourceLoc& loc, const interp::canon::FeedLine& f) {
-        PathSegment seg = base(loc, f.end_mm);
+        PathSegment seg = base(loc, f.end_mm, f.flags);
         seg.feed_mm_s = feed_mm_s_;
         add(seg);
     }
     void handle(const interp::SourceLoc& loc, const interp::canon::Arc& a) {
-        PathSegment seg = base(loc, a.end_mm);
+        PathSegment seg = base(loc, a.end_mm, a.flags);
         seg.kind = SegmentKind::Arc;
         const interp::PlaneAxes axes = interp::plane_axes(a.plane);
         seg.plane_first = axes.first;
@@ -57,6 +57,11 @@ class SegmentSink final : public interp::CanonSink {
     void handle(const interp::SourceLoc&, const interp::canon::SetFeedRate& f) {
         feed_mm_s_ = f.feed_mm_s;
     }
+    // G61 (exact path: tolerance 0) or G64 P (P <= 0: the bench's default tolerance).
+    void handle(const interp::SourceLoc&, const interp::canon::SetBlending& b) {
+        tolerance_mm_ =
+            b.exact ? 0.0 : (b.tolerance_mm > 0 ? b.tolerance_mm : default_tolerance_mm_);
+    }
     // A dwell stops the machine: the move before it ends at rest.
     void handle(const interp::SourceLoc&, const interp::canon::Dwell& d) {
         if (!prog_.segments.empty()) prog_.segments.back().exact_stop = true;
@@ -65,17 +70,20 @@ class SegmentSink final : public interp::CanonSink {
     template <class Other>
     void handle(const interp::SourceLoc&, const Other&) {}
 
-    PathSegment base(const interp::SourceLoc& loc, const interp::AxisVec& end) const {
+    PathSegment base(const interp::SourceLoc& loc, const interp::AxisVec& end,
+                     const interp::canon::MoveFlags& flags) const {
         PathSegment seg;
         seg.end_mm = to_axes(end);
         seg.tolerance_mm = tolerance_mm_;
+        seg.exact_stop = flags.exact_stop;  // G09
         seg.line = loc.line;
         return seg;
     }
     void add(const PathSegment& seg) { prog_.segments.push_back(seg); }
 
     BenchProgram& prog_;
-    double tolerance_mm_;
+    double default_tolerance_mm_;
+    double tolerance_mm_;  // the active G61 / G64 P
     double feed_mm_s_ = 0;
 };
 

@@ -16,8 +16,9 @@ struct BenchProgram {
     double dwell_s = 0;  // total G04 dwell time; the bench adds it to both motion time and bound
 };
 
-// default_tolerance_mm is the blend tolerance (G64 P) of every move unless the program sets
-// its own. Throws std::runtime_error "file:line:col: why" for a bad program.
+// default_tolerance_mm is the blend tolerance of every move until the program sets its own
+// (G64 P; G61 = 0, exact path; G64 without P = back to the default); G09 stops at a move's
+// end. Throws std::runtime_error "file:line:col: why" for a bad program.
 BenchProgram read_program(const std::string& path, double default_tolerance_mm);
 
 // Length of a programmed move starting at start_mm (arc length for arcs).
