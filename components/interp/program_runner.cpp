@@ -60,6 +60,11 @@ class ProgramRunner::LiveMachine final : public interp::MachineQuery {
     bool incremental_mode() override { return exec_.incremental_mode(); }
     bool cycle_return_to_r() override { return exec_.cycle_return_to_r(); }
     std::optional<double> setting(std::string_view name) override { return exec_.setting(name); }
+    // Writable named parameters (#FIXEDCALI_REC) persist in the executor's settings.
+    bool can_write_setting(std::string_view name) override { return exec_.can_write_setting(name); }
+    void write_setting(std::string_view name, double value) override {
+        exec_.write_setting(name, value);
+    }
 
   private:
     ProgramRunner& runner_;
