@@ -69,7 +69,9 @@ class ProgramRunner {
     bool waiting() const noexcept { return waiting_.load(std::memory_order_relaxed); }
     bool running() const noexcept { return running_.load(std::memory_order_relaxed); }
     int line() const noexcept { return line_.load(std::memory_order_relaxed); }
-    std::uint32_t barriers_sent() const noexcept { return barriers_.load(std::memory_order_relaxed); }
+    std::uint32_t barriers_sent() const noexcept {
+        return barriers_.load(std::memory_order_relaxed);
+    }
     // "file:line:col: reason", once failed() is true.
     std::string error() const;
     // Configuration world, while stopped: the end record (with any error) is in the stream.

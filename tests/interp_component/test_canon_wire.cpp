@@ -115,7 +115,8 @@ void expect_same(const Canon& a, const Canon& b) {
 TEST(CanonWire, EverySampleRoundTripsWithItsTextAndLocation) {
     std::vector<Canon> in;
     int line = 1;
-    for (CanonCommand& c : samples()) in.push_back(Canon{SourceLoc{"part.ngc", line++, 3 + line % 5}, c});
+    for (CanonCommand& c : samples())
+        in.push_back(Canon{SourceLoc{"part.ngc", line++, 3 + line % 5}, c});
     const std::vector<Canon> out = round_trip(in);
     ASSERT_EQ(out.size(), in.size());
     for (std::size_t i = 0; i < in.size(); ++i) {
@@ -166,8 +167,9 @@ TEST(CanonWire, LongTextsAreSplitOverContinuationRecordsAndJoined) {
     // One file record (+1 continuation for the name), the command, and the text's records.
     const std::size_t per_record = (wire::kWireFields - 1) * 8;
     EXPECT_EQ(records.size(), 2 + 1 + (text.size() + per_record - 1) / per_record);
-    const std::vector<Canon> out = round_trip({Canon{SourceLoc{"m.ngc", 9, 1}, canon::Message{text}},
-                                               Canon{SourceLoc{"m.ngc", 10, 1}, canon::Sync{}}});
+    const std::vector<Canon> out =
+        round_trip({Canon{SourceLoc{"m.ngc", 9, 1}, canon::Message{text}},
+                    Canon{SourceLoc{"m.ngc", 10, 1}, canon::Sync{}}});
     ASSERT_EQ(out.size(), 2u);
     EXPECT_EQ(std::get<canon::Message>(out[0].cmd).text, text);
     EXPECT_EQ(out[1].loc.line, 10);

@@ -79,8 +79,8 @@ class FakeMachine : public interpcomp::MachineLink {
 class Program {
   public:
     explicit Program(const std::string& text)
-        : path_(fs::temp_directory_path() /
-                ("runner_test_" + std::to_string(::getpid()) + "_" + std::to_string(next_++) + ".ngc")) {
+        : path_(fs::temp_directory_path() / ("runner_test_" + std::to_string(::getpid()) + "_" +
+                                             std::to_string(next_++) + ".ngc")) {
         std::ofstream(path_) << text;
     }
     ~Program() { fs::remove(path_); }
@@ -121,7 +121,9 @@ TEST(ProgramRunner, ReadWaitsAtABarrierThenUsesTheLivePosition) {
     lines = machine.lines();
     // The Y move goes to the machine's X (7.5 from the fake machine), not the model's 10.
     bool y_from_machine = false;
-    for (const auto& l : lines) y_from_machine = y_from_machine || (l.rfind("4 feed ", 0) == 0 && l.find("Y7.5") != std::string::npos);
+    for (const auto& l : lines)
+        y_from_machine =
+            y_from_machine || (l.rfind("4 feed ", 0) == 0 && l.find("Y7.5") != std::string::npos);
     EXPECT_TRUE(y_from_machine) << ::testing::PrintToString(lines);
     EXPECT_EQ(lines.back(), "end");
     EXPECT_FALSE(runner.failed());
@@ -136,7 +138,8 @@ TEST(ProgramRunner, StandaloneReadsTheModelWithoutWaiting) {
     runner.stop();
     bool y_from_model = false;
     for (const auto& l : machine.lines())
-        y_from_model = y_from_model || (l.rfind("4 feed ", 0) == 0 && l.find("Y10") != std::string::npos);
+        y_from_model =
+            y_from_model || (l.rfind("4 feed ", 0) == 0 && l.find("Y10") != std::string::npos);
     EXPECT_TRUE(y_from_model) << ::testing::PrintToString(machine.lines());
 }
 

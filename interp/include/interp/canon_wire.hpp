@@ -71,7 +71,7 @@ class Decoder {
     Item complete();
     Record first_{};
     std::uint32_t continuations_left_ = 0;
-    std::string text_;  // bytes of the continuation records of the current item
+    std::string text_;               // bytes of the continuation records of the current item
     std::deque<std::string> files_;  // by id; a deque keeps the strings in place
     Canon command_;
     bool failed_ = false;

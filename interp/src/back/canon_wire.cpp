@@ -166,8 +166,8 @@ class Archive {
     explicit Archive(std::string_view what) : what_(what) {}
     std::size_t next_word() {
         if (word_ >= kWireFields)
-            throw Error(fmt::format("canonical command '{}' has more fields than a record holds",
-                                    what_));
+            throw Error(
+                fmt::format("canonical command '{}' has more fields than a record holds", what_));
         return word_++;
     }
     // Word and bit for the next boolean.
@@ -192,7 +192,9 @@ struct Probe {
     void operator()(T&...) {}
 };
 template <class T>
-concept Listed = requires(Probe& p, T& t) { fields(p, t); };
+concept Listed = requires(Probe& p, T& t) {
+    fields(p, t);
+};
 
 struct Writer : Archive {
     Writer(Record& r, std::string& text, std::string_view what)
@@ -210,15 +212,13 @@ struct Writer : Archive {
     }
     void put(double v) { record_[next_word()] = std::bit_cast<std::uint64_t>(v); }
     template <class T>
-        requires std::is_integral_v<T>
+    requires std::is_integral_v<T>
     void put(T v) {
         record_[next_word()] = static_cast<std::uint64_t>(static_cast<std::int64_t>(v));
     }
     template <class T>
-        requires std::is_enum_v<T>
-    void put(T v) {
-        put(static_cast<std::underlying_type_t<T>>(v));
-    }
+    requires std::is_enum_v<T>
+    void put(T v) { put(static_cast<std::underlying_type_t<T>>(v)); }
     template <class T, std::size_t N>
     void put(std::array<T, N>& a) {
         for (T& x : a) put(x);
@@ -233,10 +233,8 @@ struct Writer : Archive {
         text_ += s;
     }
     template <class T>
-        requires Listed<T>
-    void put(T& nested) {
-        fields(*this, nested);
-    }
+    requires Listed<T>
+    void put(T& nested) { fields(*this, nested); }
 
     Record& record_;
     std::string& text_;
@@ -258,12 +256,10 @@ struct Reader : Archive {
     }
     void get(double& v) { v = std::bit_cast<double>(record_[next_word()]); }
     template <class T>
-        requires std::is_integral_v<T>
-    void get(T& v) {
-        v = static_cast<T>(static_cast<std::int64_t>(record_[next_word()]));
-    }
+    requires std::is_integral_v<T>
+    void get(T& v) { v = static_cast<T>(static_cast<std::int64_t>(record_[next_word()])); }
     template <class T>
-        requires std::is_enum_v<T>
+    requires std::is_enum_v<T>
     void get(T& v) {
         std::underlying_type_t<T> raw{};
         get(raw);
@@ -290,10 +286,8 @@ struct Reader : Archive {
         text_at_ += size;
     }
     template <class T>
-        requires Listed<T>
-    void get(T& nested) {
-        fields(*this, nested);
-    }
+    requires Listed<T>
+    void get(T& nested) { fields(*this, nested); }
 
     const Record& record_;
     std::string_view text_;
@@ -413,9 +407,10 @@ void Encoder::end(std::string_view error, std::vector<Record>& out) {
 Decoder::Item Decoder::feed(const Record& r) {
     if (continuations_left_ > 0) {
         if (type_of(r) != Type::Continuation)
-            throw Error(fmt::format("canonical stream: expected {} more text record(s), got a "
-                                    "record of type {}",
-                                    continuations_left_, static_cast<int>(type_of(r))));
+            throw Error(
+                fmt::format("canonical stream: expected {} more text record(s), got a "
+                            "record of type {}",
+                            continuations_left_, static_cast<int>(type_of(r))));
         const char* bytes = reinterpret_cast<const char*>(&r[1]);
         text_.append(bytes, kTextBytesPerRecord);
         if (--continuations_left_ > 0) return Item::None;
@@ -441,8 +436,8 @@ Decoder::Item Decoder::complete() {
             // Texts are padded to whole records; the name ends at the first NUL.
             const std::string name = text_.substr(0, text_.find('\0'));
             if (first_[1] != files_.size())
-                throw Error(fmt::format("canonical stream: file id {} announced out of order",
-                                        first_[1]));
+                throw Error(
+                    fmt::format("canonical stream: file id {} announced out of order", first_[1]));
             files_.push_back(name);
             return Item::None;
         }
