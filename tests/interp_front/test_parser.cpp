@@ -258,3 +258,17 @@ TEST_F(ParserFixture, ErrorLabelSyntax) {
               "p.nc:12:2: subprogram name 'a b' may only contain letters, digits and '_'");
     EXPECT_EQ(error("O\"\""), "p.nc:12:2: empty subprogram name");
 }
+
+// EX-32 (S1 §3.3): the arc examples' start point is only in a figure and |IJ| ≠ R, so FEATURES
+// asks for a syntax test only: the words parse with the written values.
+TEST_F(ParserFixture, Ex32ArcExamplesParse) {
+    const Block& a = parse("G17 G90 G02 X20 Y10 I-2 J-14", ncstudio_v54_dialect()).block;
+    EXPECT_EQ(a.g.size(), 3u);
+    EXPECT_EQ(a.get('I'), -2.0);
+    EXPECT_EQ(a.get('J'), -14.0);
+    const Block& r = parse("G02 X20 Y10 R12", ncstudio_v54_dialect()).block;
+    EXPECT_EQ(r.get('R'), 12.0);
+    const Block& b = parse("G03 X10 Y22 I-12 J-2", ncstudio_v54_dialect()).block;
+    EXPECT_EQ(b.get('X'), 10.0);
+    EXPECT_EQ(b.get('J'), -2.0);
+}

@@ -267,7 +267,22 @@ void SummarySink::line_to(const AxisVec& end, bool rapid) {
     pos_ = end;
 }
 
+namespace {
+
+// A stand-in for the angle of (x, y) that grows with it through [0, 4) and is exactly 0, 1, 2, 3
+// at +x, +y, -x, -y, so "is this quadrant point inside the sweep" needs no trigonometry.
+double pseudo_angle(double x, double y) {
+    const double s = std::abs(x) + std::abs(y);
+    if (s == 0) return 0;
+    const double t = x / s;
+    return y >= 0 ? 1 - t : 3 + t;
+}
+
+}  // namespace
+
 // Extents include the arc's quadrant points inside its sweep; the length is the helix length.
+// One atan2 per arc (the sweep, for the length): the extents only compare pseudo-angles, and a
+// quadrant point's Z may be taken as the start's because the start and end already bound Z.
 void SummarySink::arc(const canon::Arc& a) {
     const PlaneAxes pa = plane_axes(a.plane);
     const double sx = pos_[pa.first] - a.centre_mm[pa.first];
@@ -276,33 +291,33 @@ void SummarySink::arc(const canon::Arc& a) {
     const double ey = a.end_mm[pa.second] - a.centre_mm[pa.second];
     const double r = std::hypot(sx, sy);
     const double two_pi = 2 * std::numbers::pi;
-    const double a0 = std::atan2(sy, sx);
-    double d = a.turns > 0 ? std::atan2(ey, ex) - a0 : a0 - std::atan2(ey, ex);
+    // Counter-clockwise angle from start to end in (-pi, pi], turned to the arc's direction.
+    double d = std::atan2(sx * ey - sy * ex, sx * ex + sy * ey);
+    if (a.turns < 0) d = -d;
     while (d <= 1e-12) d += two_pi;
-    while (d > two_pi + 1e-12) d -= two_pi;
     const double sweep = d + two_pi * (std::abs(a.turns) - 1);
-    const double dir = a.turns > 0 ? 1.0 : -1.0;
     extend({pos_[0], pos_[1], pos_[2]});
     ++moves_;
-    const double z0 = pos_[pa.normal];
-    const double dz = a.end_mm[pa.normal] - z0;
-    // Quadrant points sit at exact multiples of 90 degrees: their cosines and sines need no
-    // trigonometry (which was a fifth of `cnc check`'s time on arc programs).
     static constexpr double kCos[4] = {1, 0, -1, 0};
     static constexpr double kSin[4] = {0, 1, 0, -1};
-    for (int k = 0; k < 4 * (std::abs(a.turns) + 1); ++k) {
-        const double q = k * std::numbers::pi / 2;  // angle of a quadrant point after the start
-        double off = std::fmod(dir * (q - a0), two_pi);
-        if (off < 0) off += two_pi;
-        if (off > sweep) continue;
+    const bool full = sweep >= two_pi - 1e-12;
+    const double ps = pseudo_angle(sx, sy);
+    // Position of a pseudo-angle along the arc from its start, in [0, 4).
+    const auto along = [&](double p) {
+        double v = a.turns > 0 ? p - ps : ps - p;
+        return v < 0 ? v + 4 : v;
+    };
+    const double end_at = along(pseudo_angle(ex, ey));
+    for (int k = 0; k < 4; ++k) {
+        if (!full && along(k) > end_at) continue;
         std::array<double, 3> p{};
-        p[pa.first] = a.centre_mm[pa.first] + r * kCos[k % 4];
-        p[pa.second] = a.centre_mm[pa.second] + r * kSin[k % 4];
-        p[pa.normal] = z0 + dz * off / sweep;
+        p[pa.first] = a.centre_mm[pa.first] + r * kCos[k];
+        p[pa.second] = a.centre_mm[pa.second] + r * kSin[k];
+        p[pa.normal] = pos_[pa.normal];
         extend(p);
     }
     extend({a.end_mm[0], a.end_mm[1], a.end_mm[2]});
-    const double len = std::hypot(r * sweep, dz);
+    const double len = std::hypot(r * sweep, a.end_mm[pa.normal] - pos_[pa.normal]);
     feed_len_ += len;
     if (feed_mm_s_ > 0) feed_time_ += len / feed_mm_s_;
     pos_ = a.end_mm;

@@ -303,9 +303,10 @@ std::optional<cycles::CustomCycles::Run> Interpreter::plan_custom_cycle(
             call = i;
             info.custom_g = customs_[i].code - kCustomGFlag;
         }
+    // Most blocks: no custom cycle called or active; decided before looking at the G codes.
+    if (!info.custom_g && !next.active()) return std::nullopt;
     for (const int g : {0, 10, 20, 30, 800}) info.cancels = info.cancels || b.has_g(g);
     for (int n = 73; n <= 89; ++n) info.cancels = info.cancels || b.has_g(n * 10);
-    if (!info.custom_g && !next.active()) return std::nullopt;
     if (!info.custom_g && !info.cancels) {
         // While a custom cycle is active, only a block of positions and modal switches re-runs
         // it; G04 P, G28 X, G92 X … keep their words, as with the built-in cycles.
