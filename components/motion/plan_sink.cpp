@@ -50,17 +50,17 @@ class PlanSink final : public interp::CanonSink {
 
   private:
     void handle(const interp::SourceLoc& loc, const interp::canon::Traverse& t) {
-        motion::PathSegment seg = base_segment(loc, t.end_mm);
+        motion::PathSegment seg = base_segment(loc, t.end_mm, t.flags);
         seg.rapid = true;
         push(loc, seg);
     }
     void handle(const interp::SourceLoc& loc, const interp::canon::FeedLine& f) {
-        motion::PathSegment seg = base_segment(loc, f.end_mm);
+        motion::PathSegment seg = base_segment(loc, f.end_mm, f.flags);
         seg.feed_mm_s = feed_mm_s_;
         push(loc, seg);
     }
     void handle(const interp::SourceLoc& loc, const interp::canon::Arc& a) {
-        motion::PathSegment seg = base_segment(loc, a.end_mm);
+        motion::PathSegment seg = base_segment(loc, a.end_mm, a.flags);
         seg.kind = motion::SegmentKind::Arc;
         const interp::PlaneAxes axes = interp::plane_axes(a.plane);
         seg.plane_first = axes.first;
@@ -70,6 +70,14 @@ class PlanSink final : public interp::CanonSink {
         seg.turns = a.turns;
         seg.feed_mm_s = feed_mm_s_;
         push(loc, seg);
+    }
+    // G61: tolerance 0, the planner's exact path (non-tangent corners are stopped at). G64 P:
+    // that tolerance; G64 alone (or P0): the machine's, motion.blend-tolerance.
+    void handle(const interp::SourceLoc&, const interp::canon::SetBlending& b) {
+        if (b.exact)
+            tolerance_mm_ = 0;
+        else
+            tolerance_mm_ = b.tolerance_mm > 0 ? b.tolerance_mm : cfg_.blend_tolerance_mm;
     }
     void handle(const interp::SourceLoc&, const interp::canon::SetFeedRate& f) {
         feed_mm_s_ = f.feed_mm_s;
@@ -139,10 +147,12 @@ class PlanSink final : public interp::CanonSink {
         feeder_.count_ignored();
     }
 
-    motion::PathSegment base_segment(const interp::SourceLoc& loc, const interp::AxisVec& end) {
+    motion::PathSegment base_segment(const interp::SourceLoc& loc, const interp::AxisVec& end,
+                                     const interp::canon::MoveFlags& flags) {
         motion::PathSegment seg;
         seg.end_mm = to_axes(end);
-        seg.tolerance_mm = cfg_.blend_tolerance_mm;
+        seg.tolerance_mm = tolerance_mm_;
+        seg.exact_stop = flags.exact_stop;  // G09
         seg.line = loc.line;
         for (int k = 0; k < motion::kAxes; ++k) {
             if (!cfg_.axis_present[k] && std::fabs(seg.end_mm[k] - pos_mm_[k]) > 1e-9)
@@ -208,6 +218,7 @@ class PlanSink final : public interp::CanonSink {
     ProgramFeeder& feeder_;
     motion::AxisArray pos_mm_;
     double feed_mm_s_ = 0;
+    double tolerance_mm_ = cfg_.blend_tolerance_mm;  // the G61/G64 mode in force
 };
 
 // Adds to `e` the points of the circle (centre c, radius r, in axes i, j) at the multiples of
