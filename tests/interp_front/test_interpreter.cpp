@@ -55,6 +55,14 @@ struct InterpFixture : ::testing::Test {
     }
 };
 
+struct WarningList : WarningSink {
+    std::vector<std::string> text;
+    void warning(const SourceLoc& loc, const std::string& t) override {
+        text.push_back(std::string(loc.file) + ":" + std::to_string(loc.line) + ":" +
+                       std::to_string(loc.col) + ": " + t);
+    }
+};
+
 using Lines = std::vector<int>;
 using Values = std::vector<double>;
 
@@ -218,8 +226,17 @@ TEST_F(InterpFixture, ErrorCustomGWithCall) {
               "main.nc:1:1: custom G86 and a subprogram call in one block");
 }
 
-TEST_F(InterpFixture, ErrorM17OutsideSubprogram) {
-    EXPECT_EQ(run_error("G0 X1\nM17\n"), "main.nc:2:1: M17 outside a subprogram");
+// M17-1 REC: M17 in the main program ends it as M30, with a warning; later lines do not run.
+TEST_F(InterpFixture, M17InMainProgramEndsItAsM30WithAWarning) {
+    WarningList w;
+    options.warnings = &w;
+    run("G0 X1\nM17\nG0 X2\n");
+    ASSERT_EQ(exec.blocks.size(), 2u);
+    EXPECT_TRUE(exec.blocks[1].has_m(30));
+    EXPECT_EQ(exec.blocks[1].loc.line, 2);
+    EXPECT_TRUE(exec.ends.empty());
+    EXPECT_EQ(w.text, (std::vector<std::string>{
+                          "main.nc:2:1: M17 in the main program ends it as M30 does"}));
 }
 
 TEST_F(InterpFixture, ErrorSubprogramRunsIntoNextLabel) {
@@ -519,14 +536,6 @@ TEST_F(InterpFixture, WritableNamedParameterNeedsAMachineThatKeepsSettings) {
               "main.nc:1:1: named parameter #FIXEDCALI_REC cannot be stored on this machine (no "
               "settings file)");
 }
-
-struct WarningList : WarningSink {
-    std::vector<std::string> text;
-    void warning(const SourceLoc& loc, const std::string& t) override {
-        text.push_back(std::string(loc.file) + ":" + std::to_string(loc.line) + ":" +
-                       std::to_string(loc.col) + ": " + t);
-    }
-};
 
 TEST_F(InterpFixture, DuplicateSequenceNumberIsAWarningNotAnError) {
     WarningList w;

@@ -369,7 +369,20 @@ void Interpreter::handle_return(const ReturnRequest& r, const SourcePos& after_c
 }
 
 void Interpreter::return_in_main(const ReturnRequest& r, const SourcePos& after_call) {
-    if (r.m != 99) throw Error(r.loc, "M" + std::to_string(r.m) + " outside a subprogram");
+    if (r.m != 99) {
+        // M17-1 REC: M17 in a main program ends it as M30 does, with a warning.
+        if (options_.warnings != nullptr)
+            options_.warnings->warning(r.loc, "M" + std::to_string(r.m) +
+                                                  " in the main program ends it as M30 does");
+        Block end;
+        end.loc = r.loc;
+        end.m.push_back(30);
+        end.m_col.push_back(r.loc.col);
+        finished_ = true;
+        stack_.clear();
+        executor_.execute(end);
+        return;
+    }
     if (!options_.main_m99_loops) {
         end_program(r.loc);
         return;
