@@ -371,13 +371,32 @@ TEST(CutterCompShortMoves, StepSmallerThanTheToolGoesRoundItsCorner) {
                      "L 10,1.1 -> 20,1.1 contour #4", "L 20,1.1 -> 25,0.1 cancel #5"}));
 }
 
+TEST(CutterCompShortMoves, ChamferUsedUpByBothItsCornersIsSkipped) {
+    // A 30° left turn at (10, 0) cut by an isosceles chamfer (9.9,0)→(10.0866,0.05) of length
+    // 0.193 (15°), G41 r = 1. Each of its corners trims r·tan(7.5°) = 0.132 off its offset: the
+    // first leaves 0.062 (< r, so line 2's piece waits), the second would need 0.132 more. The
+    // chamfer is skipped; lines 2 and 4 meet where the tool touches both: on the bisector of the
+    // original corner, x = 10 − r·tan(15°) = 9.73205, y = 1, which is 1.0094 from the chamfer.
+    const double c30 = std::cos(M_PI / 6), s30 = 0.5;
+    const Vec2 b_end(10 + 0.1 * c30, 0.1 * s30);
+    Compensator c(Config{}, {0, -5});
+    const Lines out =
+        run(c, {line(0, 0, L, 1, 1), line(9.9, 0, L, 1, 2), line(b_end.x(), b_end.y(), L, 1, 3),
+                line(b_end.x() + 10 * c30, b_end.y() + 10 * s30, L, 1, 4),
+                line(b_end.x() + 20 * c30, b_end.y() + 20 * s30, Off, 1, 5)});
+    ASSERT_EQ(out.size(), 4u);
+    EXPECT_EQ(out[1], "L 0,1 -> 9.73205,1 contour #2");
+    EXPECT_EQ(out[2].substr(0, 15), "L 9.73205,1 -> ");
+    EXPECT_NE(out[2].find("contour #4"), std::string::npos) << out[2];
+    for (const auto& o : out) EXPECT_EQ(o.find("#3"), std::string::npos) << o;
+}
+
 TEST(CutterCompShortMoves, SlotNarrowerThanTheToolIsAGouge) {
     // +X, 0.2 up, −X back: a slot 0.2 wide for a tool of radius 1 on its inside. The first and
     // last offsets, y = 1 and y = −0.8, never meet: no path keeps 1 from all three moves.
-    const CompError e =
-        error_of({line(0, 0, L, 1, 1), line(10, 0, L, 1, 2), line(10, 0.2, L, 1, 3),
-                  line(0, 0.2, L, 1, 4), line(0, 5, Off, 1, 5)},
-                 Config{}, {0, -5});
+    const CompError e = error_of({line(0, 0, L, 1, 1), line(10, 0, L, 1, 2), line(10, 0.2, L, 1, 3),
+                                  line(0, 0.2, L, 1, 4), line(0, 5, Off, 1, 5)},
+                                 Config{}, {0, -5});
     EXPECT_STREQ(e.what(),
                  "cutter comp: gouge: the tool radius 1 does not fit the inside corner (with the "
                  "move at line 2)");
@@ -438,14 +457,15 @@ TEST(CutterCompErrors, ToolLargerThanInsideArc) {
 }
 
 TEST(CutterCompErrors, GougeWhenTheToolDoesNotFitAnInsideCorner) {
-    // Inside a 10×10 square with r 6: the offsets of the right and top edges
-    // meet before the offset of the right edge starts.
+    // Inside a 10×10 square with r 6: the offsets of the bottom and right edges meet at (4, 6),
+    // leaving 4 < r of the right edge's offset, so line 2's piece waits. The top edge's offset
+    // y = 4 meets x = 4 below y = 6: the right edge is used up, so line 2 must meet line 4
+    // directly, and y = 6 and y = 4 never meet.
     const CompError e = error_of({line(0, 0, L, 6, 1), line(10, 0, L, 6, 2), line(10, 10, L, 6, 3),
                                   line(0, 10, L, 6, 4), line(0, 0, L, 6, 5)});
-    EXPECT_STREQ(
-        e.what(),
-        "cutter comp: gouge: the tool radius 6 does not fit the inside corner (with the move at "
-        "line 3)");
+    EXPECT_STREQ(e.what(),
+                 "cutter comp: gouge: the tool radius 6 does not fit the inside corner (with the "
+                 "move at line 2)");
     EXPECT_EQ(e.at_block, 4);
 }
 

@@ -33,12 +33,17 @@
 //     are trimmed to their intersection; outside → an arc of radius r around the
 //     programmed corner point, or (Config::extend_max_turn_deg) the two offset
 //     tangents extended to their intersection for mild turns.
-//   - errors (CompError, naming both blocks involved): a 180° reversal, an inside
-//     corner whose offset curves do not meet within both moves (gouge), an offset
-//     piece that comes closer than r to one of the last few contour moves at the
-//     same height (gouge, Config::gouge_check_moves; checked at 64 points), a tool
-//     radius ≥ an inside arc radius, a plane change while active, start-up or
-//     cancel on an arc, too many moves without plane motion.
+//   - a move too short for the tool at an inside corner (the offsets cross beyond its end) is
+//     skipped: the moves around it are joined directly (their offsets' crossing, or a circle of
+//     radius r about the corner point when the next corner turns away from the tool), accepted
+//     only when the gouge check proves the path keeps r from the skipped move.
+//   - errors (CompError: the block being pushed, the held block, for a gouge the contour move):
+//     a 180° reversal, an inside corner whose offset curves do not meet within both moves
+//     (gouge), an offset piece that comes closer than r to one of the last few contour moves at
+//     the same height (gouge, Config::gouge_check_moves; sampled about every r/10), a tool
+//     radius ≥ an inside arc radius, a plane change while active, start-up or cancel on an arc,
+//     too many moves without plane motion. A push that throws leaves the compensator unusable:
+//     callers that must survive an error push into a copy (see crc_stage.hpp).
 //
 // Not realtime: allocates, throws.
 
@@ -206,6 +211,10 @@ class Compensator {
     bool can_skip(const geom::Curve& next) const;
     void skip(const geom::Segment& seg, const Move& move);
     CompError corner_gouge(SourceTag earlier, SourceTag at) const;
+    bool should_defer(const geom::Curve& next, double u_next) const;
+    void emit_deferred();
+    bool consumed_from_start(const geom::Segment& seg, const geom::Curve& next,
+                             const Move& move) const;
     void link(const Move& move);
     void cancel(const Move& move);
     void end_pending_perpendicular();

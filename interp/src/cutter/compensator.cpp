@@ -88,6 +88,17 @@ struct Compensator::Pending {
     // Moves after this one too short for the tool at an inside corner: they get no offset piece;
     // the next move that leaves room joins this one directly (see join_after_skip).
     std::vector<Recent> skipped;
+    // The previous move, whose piece up to its inside corner with this move is not emitted yet:
+    // this move's offset is shorter than r after that corner, so the next corner may consume it
+    // from its start, and then the previous move is joined to the next one directly.
+    struct Deferred {
+        OutMove piece;
+        Segment seg;
+        Curve curve;
+        double u_start = 0;
+        Move move;
+    };
+    std::optional<Deferred> deferred;
 
     void become_contour(const Segment& s, const Curve& c, double u, const Move& m, SourceTag on,
                         std::size_t window) {
@@ -99,6 +110,7 @@ struct Compensator::Pending {
         on_tag = on;
         upcoming.reset();
         skipped.clear();
+        deferred.reset();
         remember(Recent{s, m.tag, bounds(s)}, window);
     }
 
@@ -382,6 +394,20 @@ void Compensator::join(const Move& move) {
         join_after_skip(seg, next, move);
         return;
     }
+    if (a.deferred && consumed_from_start(seg, next, move)) {
+        // The held move has no room left: the deferred move takes its place and it is skipped.
+        Pending::Deferred d = std::move(*a.deferred);
+        const Pending::Recent held{a.seg, a.move.tag, bounds(a.seg)};
+        a.deferred.reset();
+        a.seg = d.seg;
+        a.curve = d.curve;
+        a.u_start = d.u_start;
+        a.move = d.move;
+        a.skipped.push_back(held);
+        join_after_skip(seg, next, move);
+        return;
+    }
+    emit_deferred();
     const Vec2 t_in = a.seg.tangent(1.0);
     const Vec2 t_out = seg.tangent(0.0);
     const double turn_sin = geom::cross(t_in, t_out);
@@ -401,8 +427,15 @@ void Compensator::join(const Move& move) {
             skip(seg, move);
             return;
         }
-        emit_piece(a.curve.piece(a.u_start, best->first), a.move.rapid, Role::Contour, a.move.tag);
         u_next = best->second;
+        if (should_defer(next, u_next)) {
+            Pending::Deferred d{a.curve.piece(a.u_start, best->first), a.seg, a.curve, a.u_start,
+                                a.move};
+            a.become_contour(seg, next, u_next, move, a.on_tag, config_.gouge_check_moves);
+            a.deferred = std::move(d);
+            return;
+        }
+        emit_piece(a.curve.piece(a.u_start, best->first), a.move.rapid, Role::Contour, a.move.tag);
     } else {
         // Outside corner: go around the corner point at distance r.
         emit_piece(a.curve.piece(a.u_start, 1.0), a.move.rapid, Role::Contour, a.move.tag);
@@ -428,6 +461,38 @@ void Compensator::join(const Move& move) {
     }
     flush_held();
     a.become_contour(seg, next, u_next, move, a.on_tag, config_.gouge_check_moves);
+}
+
+// Deferring needs the gouge check (it proves the later joint) and nothing held between the two
+// moves (a Z move there must run at the corner, before the next move's piece).
+bool Compensator::should_defer(const Curve& next, double u_next) const {
+    if (config_.gouge_check_moves == 0 || !held_.empty() || full_circle(next)) return false;
+    const double length = next.shape == Shape::Line ? next.len : next.radius * next.sweep;
+    return (1.0 - u_next) * length < pending_->move.radius_mm;
+}
+
+void Compensator::emit_deferred() {
+    Pending& a = *pending_;
+    if (!a.deferred) return;
+    const Pending::Deferred d = std::move(*a.deferred);
+    a.deferred.reset();
+    emit_piece(d.piece, d.move.rapid, Role::Contour, d.move.tag);
+}
+
+// At an inside corner after the held move: its offset and the next one cross before what is left
+// of the held move's offset (the previous corner already used it up).
+bool Compensator::consumed_from_start(const Segment& seg, const Curve& next,
+                                      const Move& move) const {
+    const Pending& a = *pending_;
+    const double turn_sin = geom::cross(a.seg.tangent(1.0), seg.tangent(0.0));
+    if (side_sign(move.side) * turn_sin <= kParallel) return false;
+    if (inside_joint(a.curve, a.u_start, next, seg.start)) return false;
+    for (const Vec2& p : geom::intersections(a.curve, next)) {
+        const double ua = a.curve.param(p);
+        const double un = next.param(p);
+        if (ua < a.u_start && un >= -next.tol_u() && un <= 1.0 + next.tol_u()) return true;
+    }
+    return false;
 }
 
 CompError Compensator::corner_gouge(SourceTag earlier, SourceTag at) const {
@@ -468,6 +533,7 @@ void Compensator::skip(const Segment& seg, const Move& move) {
 // round that point to the next move's offset (the transition circle of S2 §3.4.4).
 void Compensator::join_after_skip(const Segment& seg, const Curve& next, const Move& move) {
     Pending& a = *pending_;
+    emit_deferred();
     const Pending::Recent& last = a.skipped.back();
     const Vec2 t_in = last.seg.tangent(1.0);
     const Vec2 t_out = seg.tangent(0.0);
@@ -538,6 +604,7 @@ void Compensator::cancel(const Move& move) {
             const auto exit_offset = geom::offset(seg, side_sign(a.move.side) * a.move.radius_mm);
             const auto joint = inside_joint(a.curve, a.u_start, *exit_offset, seg.start);
             if (joint) {
+                emit_deferred();
                 emit_piece(a.curve.piece(a.u_start, joint->first), a.move.rapid, Role::Contour,
                            a.move.tag);
                 a.kind = Pending::Kind::Resume;
@@ -563,6 +630,7 @@ void Compensator::end_pending_perpendicular() {
             break;
         }
         case Pending::Kind::Contour:
+            emit_deferred();
             emit_piece(p.curve.piece(p.u_start, 1.0), p.move.rapid, Role::Contour, p.move.tag);
             break;
         case Pending::Kind::Resume:
