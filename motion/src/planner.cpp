@@ -231,29 +231,40 @@ double segment_dist2(const AxisArray& q, const AxisArray& a, const AxisArray& b)
     return d;
 }
 
-// The piece [s0, s1] of e as a chain of chords, and how far the curve may bulge beyond them.
+// The piece [s0, s1] of e as a chain of chords (one for a line), and how far the curve may
+// bulge beyond them.
 struct Chords {
     std::array<AxisArray, kDeviationChords + 1> pts;
+    int count = 0;  // chords
     double sagitta_mm = 0;
 };
 Chords chords(const Element& e, double s0, double s1) {
     Chords c;
+    c.count = e.kind == ElementKind::Line ? 1 : kDeviationChords;
     CurvePoint cp;
-    for (int i = 0; i <= kDeviationChords; ++i) {
-        evaluate(e, s0 + (s1 - s0) * i / kDeviationChords, cp);
+    for (int i = 0; i <= c.count; ++i) {
+        evaluate(e, s0 + (s1 - s0) * i / c.count, cp);
         c.pts[i] = cp.p;
     }
     if (e.kind == ElementKind::Arc) {
-        double h = (s1 - s0) / kDeviationChords;
+        double h = (s1 - s0) / c.count;
         c.sagitta_mm = h * h / (8 * e.radius_mm);
     }
     return c;
 }
 
+// Squared distance from q to the chain, through the two chords beside its nearest vertex. Where
+// that misses the nearest chord the result is larger than the true distance: the deviation
+// check stays on the safe side.
 double chain_dist2(const AxisArray& q, const Chords& c) {
+    int near = 0;
     double best = kInf;
-    for (int i = 0; i < kDeviationChords; ++i)
-        best = std::min(best, segment_dist2(q, c.pts[i], c.pts[i + 1]));
+    for (int i = 0; i <= c.count; ++i) {
+        double d = dist2(q, c.pts[i]);
+        if (d < best) best = d, near = i;
+    }
+    if (near > 0) best = std::min(best, segment_dist2(q, c.pts[near - 1], c.pts[near]));
+    if (near < c.count) best = std::min(best, segment_dist2(q, c.pts[near], c.pts[near + 1]));
     return best;
 }
 
