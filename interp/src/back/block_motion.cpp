@@ -114,25 +114,31 @@ void BlockRun::move_arc(bool ccw) {
     }
 
     // Into machine coordinates: the plane must stay a machine plane and circles stay circles.
-    const Eigen::Matrix3d L = xf().matrix().linear();
-    const Eigen::Vector3d n = L.col(pa.normal);
-    int target_normal = -1;
-    for (int k = 0; k < 3; ++k) {
-        const double rest = n.norm() - std::abs(n[k]);
-        if (std::abs(rest) < 1e-9 * n.norm()) target_normal = k;
+    // Without programmed transforms (most arcs) both hold trivially.
+    Plane mp = st.motion.plane;
+    bool flipped = false;
+    if (!xf().identity()) {
+        const Eigen::Matrix3d L = xf().matrix().linear();
+        const Eigen::Vector3d n = L.col(pa.normal);
+        int target_normal = -1;
+        for (int k = 0; k < 3; ++k) {
+            const double rest = n.norm() - std::abs(n[k]);
+            if (std::abs(rest) < 1e-9 * n.norm()) target_normal = k;
+        }
+        if (target_normal < 0)
+            fail(b_.loc, "arc plane is not a machine plane after the programmed rotation");
+        mp = target_normal == 2 ? Plane::XY : target_normal == 1 ? Plane::ZX : Plane::YZ;
+        const PlaneAxes mt = plane_axes(mp);
+        Eigen::Matrix2d B;
+        B << L(mt.first, pa.first), L(mt.first, pa.second), L(mt.second, pa.first),
+            L(mt.second, pa.second);
+        const Eigen::Matrix2d BtB = B.transpose() * B;
+        const double s2 = 0.5 * BtB.trace();
+        if (std::abs(BtB(0, 1)) > 1e-9 * s2 || std::abs(BtB(0, 0) - BtB(1, 1)) > 1e-9 * s2)
+            fail(b_.loc, "non-uniform scaling of arc (different G51 factors on the plane axes)");
+        flipped = B.determinant() < 0;  // a mirror turns G02 into G03 (ARC-14)
     }
-    if (target_normal < 0)
-        fail(b_.loc, "arc plane is not a machine plane after the programmed rotation");
-    const Plane mp = target_normal == 2 ? Plane::XY : target_normal == 1 ? Plane::ZX : Plane::YZ;
     const PlaneAxes ma = plane_axes(mp);
-    Eigen::Matrix2d B;
-    B << L(ma.first, pa.first), L(ma.first, pa.second), L(ma.second, pa.first),
-        L(ma.second, pa.second);
-    const Eigen::Matrix2d BtB = B.transpose() * B;
-    const double s2 = 0.5 * BtB.trace();
-    if (std::abs(BtB(0, 1)) > 1e-9 * s2 || std::abs(BtB(0, 0) - BtB(1, 1)) > 1e-9 * s2)
-        fail(b_.loc, "non-uniform scaling of arc (different G51 factors on the plane axes)");
-    const bool flipped = B.determinant() < 0;  // a mirror turns G02 into G03 (ARC-14)
 
     AxisVec centre_prog = start;
     centre_prog[pa.first] = r.centre.x();

@@ -181,8 +181,12 @@ AxisVec BlockRun::offset_total() const {
 
 AxisVec BlockRun::to_machine(const AxisVec& prog) const {
     const AxisVec off = offset_total();
-    const Eigen::Vector3d w = xf().apply(xyz(prog));
     AxisVec m{};
+    if (xf().identity()) {  // the common case: no affine product needed
+        for (int a = 0; a < kMachineAxes; ++a) m[a] = prog[a] + off[a];
+        return m;
+    }
+    const Eigen::Vector3d w = xf().apply(xyz(prog));
     for (int a = 0; a < kMachineAxes; ++a) m[a] = (a < 3 ? w[a] : prog[a]) + off[a];
     return m;
 }
