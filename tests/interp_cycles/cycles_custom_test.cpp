@@ -171,4 +171,16 @@ TEST(V54G76, ShiftsByUAndVAtTheCycpFeed) {
     EXPECT_EQ(next[5], "feed X17 Y9 Z-10 F800");
 }
 
+TEST(V54G86, RestartsTheSpindleAtRThenRisesToTheInitialLevel) {
+    // C-45: S1 restarts the G86 spindle when the tool is back at R; under G98 the rapid to the
+    // initial level follows (the 6th edition restarts only at the return level).
+    CycleState st;
+    CycleConfig cfg;
+    cfg.g86_restart_at_r = true;
+    EXPECT_EQ(texts(st.run_block(CycleCode::G86, Words().x(5).y(5).z(-10).r(-5), manual_context(),
+                                 cfg)),
+              (Lines{"rapid X5 Y5 Z10", "rapid X5 Y5 Z-5", "feed X5 Y5 Z-10 F800", "spindle stop",
+                     "rapid X5 Y5 Z-5", "spindle restart", "rapid X5 Y5 Z10"}));
+}
+
 }  // namespace

@@ -88,6 +88,9 @@ struct CycleConfig {
     // "CYCP" speed (mm/min; 0 = the cycle's F), instead of Q in the OSS direction.
     bool g76_shift_uv = false;
     double g76_shift_feed_mm_min = 0.0;
+    // NcStudio V5.4 G86 (FEATURES G86-1, C-45): the spindle restarts once back at R, before the
+    // rapid to the initial level; the 6th edition restarts at the return level.
+    bool g86_restart_at_r = false;
 };
 
 /// The cycle-relevant words of one block, as programmed (already in mm / ms).

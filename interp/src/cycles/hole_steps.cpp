@@ -215,10 +215,17 @@ void g85(const HoleSpec& h, const CycleConfig&, const BlockContext&, Emitter& e)
 }
 
 // G86: 3) G01 to Z 4) spindle stop 5) G00 to initial/R 6) spindle restarts.
-void g86(const HoleSpec& h, const CycleConfig&, const BlockContext&, Emitter& e) {
+// V5.4 restarts at R (C-45), then goes on to the initial level under G98.
+void g86(const HoleSpec& h, const CycleConfig& cfg, const BlockContext&, Emitter& e) {
     approach(h, e);
     e.feed_to_level(h.z_mm);
     e.push(SpindleStop{});
+    if (cfg.g86_restart_at_r) {
+        e.rapid_to_level(h.r_mm);
+        e.push(SpindleRestart{});
+        e.rapid_to_level(return_level(h));
+        return;
+    }
     e.rapid_to_level(return_level(h));
     e.push(SpindleRestart{});
 }
