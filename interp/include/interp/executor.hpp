@@ -72,6 +72,7 @@ struct ExecState {
     bool started = false;  // the initial offsets have been announced
     // A move was emitted after the last Sync: reading the current point needs a sync first.
     bool moved_since_sync = false;
+    bool moved = false;  // a move was emitted in this program (C-37: units belong before it)
 };
 
 class Executor final : public BlockExecutor, public MachineQuery {

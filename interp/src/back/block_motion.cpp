@@ -266,7 +266,6 @@ cycles::CycleConfig BlockRun::cycle_config() const {
     if (auto back = setting("FIXEDCYCLE_BACK")) c.retract_mm = *back;
     if (auto oss = setting("FIXEDCYCLE_OSS")) c.oss_direction = static_cast<int>(*oss);
     c.g76_shift_uv = cfg_.v54_compat;
-    c.g86_restart_at_r = cfg_.v54_compat;
     if (auto cycp = setting("CYCP")) c.g76_shift_feed_mm_min = *cycp;
     return c;
 }
@@ -404,6 +403,7 @@ void BlockRun::program_end(bool rewind) {
     st.coord.g992_active = false;
     st.motion = MotionModal{};
     st.units = UnitsModal{};
+    st.moved = false;
     if (!(st.path == PathModal{})) {
         st.path = PathModal{};
         emit(canon::SetBlending{false, 0});

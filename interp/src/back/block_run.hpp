@@ -130,7 +130,7 @@ class BlockRun {
         else if constexpr (std::is_same_v<C, canon::Traverse> ||
                            std::is_same_v<C, canon::FeedLine> || std::is_same_v<C, canon::Arc> ||
                            std::is_same_v<C, canon::ConditionalMove>)
-            st.moved_since_sync = true;
+            st.moved_since_sync = st.moved = true;
         out_.push_back(Canon{b_.loc, CanonCommand(std::forward<T>(cmd))});
     }
     const ProgramTransform& xf() const { return xf_copy ? *xf_copy : base_xf_; }

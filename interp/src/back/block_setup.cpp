@@ -12,6 +12,9 @@ void BlockRun::step_units() {
     double mpu = st.units.mm_per_unit;
     if (g(gcode(20)) || g(gcode(70))) mpu = 25.4;
     if (g(gcode(21)) || g(gcode(71))) mpu = 1.0;
+    // C-37: NcStudio wants the units at the front of the program; later is accepted but odd.
+    if (st.moved)
+        emit(canon::Warning{"G20/G21 after a move: units belong at the start of the program"});
     st.units.mm_per_unit = mpu;
 }
 

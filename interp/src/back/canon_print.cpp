@@ -137,6 +137,8 @@ void LinuxCncPrinter::print(const CanonCommand& cmd) {
             } else if constexpr (std::is_same_v<T, canon::FeedLine>) {
                 line("STRAIGHT_FEED(" + move_args(c.end_mm) + ")");
                 exact_stop_note(c.flags);
+            } else if constexpr (std::is_same_v<T, canon::Warning>) {
+                // Not a call: rs274 prints nothing; `cnc` reports warnings on stderr.
             } else if constexpr (std::is_same_v<T, canon::SetBlending>) {
                 // rs274 prints the tolerance in program units; P0 and no P both print 0.
                 if (c.exact) {

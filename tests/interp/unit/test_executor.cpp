@@ -229,9 +229,11 @@ TEST_F(ExecTest, RejectedBlockChangesNothing) {
 
 TEST_F(ExecTest, UNIT_1_InchInputIsConvertedToMm) {
     EXPECT_EQ(run({"G20 G00 X1 Y2"}), (V{"units inch", "traverse X25.4 Y50.8 Z0"}));
+    // After the first move a unit change still applies, with the C-37 warning.
+    const std::string late = "warning \"G20/G21 after a move: units belong at the start of the program\"";
     EXPECT_EQ(run({"G70 G01 X2 F10"}),
-              (V{"feed-rate 4.2333mm/s", "units inch", "feed X50.8 Y50.8 Z0"}));
-    EXPECT_EQ(run({"G71 G00 X1"}), (V{"units mm", "traverse X1 Y50.8 Z0"}));
+              (V{late, "feed-rate 4.2333mm/s", "units inch", "feed X50.8 Y50.8 Z0"}));
+    EXPECT_EQ(run({"G71 G00 X1"}), (V{late, "units mm", "traverse X1 Y50.8 Z0"}));
 }
 
 TEST_F(ExecTest, ABS_1_IncrementalMoves) {

@@ -73,5 +73,14 @@ TEST(Mir5, NcStudioAllowsThem) {
     EXPECT_EQ(error_of({"G51.1 X0", "G92 X0", "G55"}, BackendConfig{}), "no error");
 }
 
+// C-37: units belong at the start; after a move they still apply, with a warning.
+TEST(UnitsWarning, G20AfterAMoveWarns) {
+    EXPECT_EQ(run({"G21 G00 X1", "G20"}),
+              (V{"1 units mm", "1 traverse X1 Y0 Z0",
+                 "2 warning \"G20/G21 after a move: units belong at the start of the program\"",
+                 "2 units inch"}));
+    EXPECT_EQ(run({"G20", "G00 X1"}), (V{"1 units inch", "2 traverse X25.4 Y0 Z0"}));
+}
+
 }  // namespace
 }  // namespace interp
