@@ -35,7 +35,7 @@ while [[ $# -gt 0 ]]; do
         --linuxcnc-reps) linuxcnc_reps=$2; shift 2 ;;
         --jerk) jerk_mm_s3=$2; shift 2 ;;
         --check) check_only=1; shift ;;
-        -h | --help) sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        -h | --help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         -*) echo "$0: unknown option $1" >&2; exit 64 ;;
         *) programs+=("$(realpath "$1")"); shift ;;
     esac
