@@ -266,6 +266,7 @@ cycles::CycleConfig BlockRun::cycle_config() const {
     if (auto back = setting("FIXEDCYCLE_BACK")) c.retract_mm = *back;
     if (auto oss = setting("FIXEDCYCLE_OSS")) c.oss_direction = static_cast<int>(*oss);
     c.g76_shift_uv = cfg_.v54_compat;
+    c.g86_restart_at_r = cfg_.v54_compat;
     if (auto cycp = setting("CYCP")) c.g76_shift_feed_mm_min = *cycp;
     return c;
 }
