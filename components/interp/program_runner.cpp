@@ -178,7 +178,9 @@ void ProgramRunner::open_program() {
     interp::InterpreterOptions options;
     options.main_m99_loops = false;  // a looping program would run forever
     if (!cfg_.dialect.empty()) options.dialect = interp::find_dialect(cfg_.dialect);
-    executor_ = std::make_unique<interp::Executor>(*sink_, interp::BackendConfig{});
+    interp::BackendConfig backend;
+    backend.optional_stop = true;  // M01 reaches motion, which obeys motion.optional-stop
+    executor_ = std::make_unique<interp::Executor>(*sink_, backend);
     machine_ = std::make_unique<LiveMachine>(*this, *executor_);
     interpreter_ = std::make_unique<interp::Interpreter>(*executor_, *machine_, options);
     interpreter_->open(cfg_.program_path);

@@ -474,8 +474,8 @@ class Motion : public hal::Instance {
                     pin_name(fmt::format("joint.{}.{}-lim-sw-in", r.joint, pos ? "pos" : "neg")));
             }
             case FaultCause::WaitTimeout:
-                return fmt::format("{}:{}: G906: {} did not become {} within {} s", program_path_,
-                                   r.line,
+                return fmt::format("{}:{}: G906: {} did not become {} within {} s",
+                                   feeder_ ? feeder_->program_file() : program_path_, r.line,
                                    pin_name(fmt::format("motion.digital-in-{:02}", r.action.value)),
                                    r.action.flag ? "TRUE" : "FALSE", r.action.number);
             case FaultCause::None:

@@ -68,6 +68,18 @@ void ProgramFeeder::wait_for_lead() const noexcept {
     }
 }
 
+void ProgramFeeder::remember_stream_file(std::string_view file) {
+    std::lock_guard lock(mutex_);
+    stream_file_ = file;
+    stream_file_known_ = true;
+}
+
+std::string ProgramFeeder::program_file() const {
+    if (!cfg_.program_path.empty()) return cfg_.program_path;
+    std::lock_guard lock(mutex_);
+    return stream_file_;
+}
+
 std::string ProgramFeeder::error() const {
     std::lock_guard lock(mutex_);
     return error_;
@@ -186,6 +198,7 @@ ProgramFeeder::Progress ProgramFeeder::read_stream() {
                 return Progress::End;
             case interp::wire::Decoder::Item::Command: {
                 const interp::Canon& c = decoder_->command();
+                if (!stream_file_known_) remember_stream_file(c.loc.file);
                 sink_->emit(c);
                 if (std::holds_alternative<interp::canon::Sync>(c.cmd)) {
                     // Whatever the sink made of it, the machine must come to rest here.

@@ -20,6 +20,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <string_view>
 #include <thread>
 
 #include "interp/canon_wire.hpp"
@@ -84,6 +85,9 @@ class ProgramFeeder {
     }
     // Configuration world, valid once failed() is true: "file:line:col: reason".
     std::string error() const;
+    // Configuration world: the main program's file, for messages about a record's line
+    // (program=, or the first file the canonical stream named).
+    std::string program_file() const;
 
     // Used by the canonical-command sink, on the feeder thread.
     void count_ignored() noexcept { ignored_.fetch_add(1, std::memory_order_relaxed); }
@@ -136,6 +140,9 @@ class ProgramFeeder {
     bool ready_ = false;
     bool failed_at_ready_ = false;
     std::string error_;
+    std::string stream_file_;         // guarded by mutex_
+    bool stream_file_known_ = false;  // feeder thread only
+    void remember_stream_file(std::string_view file);
 };
 
 // A record that holds `pos_mm` for `seconds` (a dwell), ending at rest like a program end.

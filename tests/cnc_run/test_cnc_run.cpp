@@ -275,6 +275,63 @@ TEST(CncRunErrors, FeedMoveWithoutFeedIsRefusedBeforeMotion) {
     EXPECT_EQ(r.err.rfind(bad.string() + ":2:", 0), 0u) << r.err;
 }
 
+// The mill's INI says [AXIS_Z] MAX_LIMIT = 0; motion_xyz.hal wires it to axis.z.max-limit.
+TEST(CncRunErrors, MoveBeyondTheIniSoftLimitIsRefused) {
+    ScratchDir scratch;
+    const fs::path high = scratch.path() / "high.ngc";
+    std::ofstream(high) << "G90 G21\nG01 X10 F600\nG00 Z5\nM30\n";
+    const RunResult r = run_cnc(
+        fmt::format("configs/sim/mill.ini '{}' --sim-clock", high.string()), scratch.path());
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find(high.string() +
+                         ":3:1: the move takes Z to 5 mm, which exceeds the soft limit "
+                         "axis.z.max-limit = 0 mm"),
+              std::string::npos)
+        << r.err;
+}
+
+// The program reaches motion through the interp component's stream, so the file name in a
+// G906 timeout comes from the stream, not from a program= argument.
+TEST(CncRunErrors, G906TimeoutNamesTheProgramFileAndLine) {
+    ScratchDir scratch;
+    const fs::path wait = scratch.path() / "wait.ngc";
+    std::ofstream(wait) << "G90 G21\nG1 X10 F6000\nG906 PLC[0] LEVEL1 P500\nG1 X20\nM30\n";
+    const RunResult r = run_cnc(
+        fmt::format("configs/sim/mill.ini '{}' --sim-clock", wait.string()), scratch.path());
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find(wait.string() +
+                         ":3: G906: motion.digital-in-00 did not become TRUE within 0.5 s"),
+              std::string::npos)
+        << r.err;
+}
+
+// M00 pauses motion; with no terminal to press Enter on, the run must not hang.
+TEST(CncRunPause, M00WithoutATerminalIsAnErrorAtItsLine) {
+    ScratchDir scratch;
+    const fs::path prog = scratch.path() / "m00.ngc";
+    std::ofstream(prog) << "G90 G21\nG1 X10 F600\nM00\nG1 X20\nM30\n";
+    const RunResult r = run_cnc(
+        fmt::format("configs/sim/mill.ini '{}' --sim-clock < /dev/null", prog.string()),
+        scratch.path());
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find(prog.string() + ":3: the program paused"), std::string::npos) << r.err;
+    EXPECT_NE(r.out.find("final position (mm): x 10.0000"), std::string::npos) << r.out;
+}
+
+TEST(CncRunPause, ResumePausesGoesOnAfterM00) {
+    ScratchDir scratch;
+    const fs::path prog = scratch.path() / "m00.ngc";
+    std::ofstream(prog) << "G90 G21\nG1 X10 F600\nM00\nG1 X20\nM30\n";
+    const RunResult r = run_cnc(
+        fmt::format("configs/sim/mill.ini '{}' --sim-clock --resume-pauses < /dev/null",
+                    prog.string()),
+        scratch.path());
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find(prog.string() + ":3: program paused; resuming"), std::string::npos)
+        << r.err;
+    EXPECT_NE(r.out.find("final position (mm): x 20.0000"), std::string::npos) << r.out;
+}
+
 TEST(CncRunErrors, TimeoutStopsWithTheLineReached) {
     ScratchDir scratch;
     const RunResult r = run_cnc(fmt::format("{} --timeout 2", kPocketArgs), scratch.path());

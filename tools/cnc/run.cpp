@@ -13,6 +13,7 @@
 #include <pthread.h>
 #include <signal.h>
 #include <sys/mman.h>
+#include <poll.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -197,6 +198,8 @@ struct MachinePins {
     // interp.done when the config loads the interp component: motion in position is the end
     // only once the interpreter has sent everything (it also stops at queue-busting reads).
     std::optional<Probe> interp_done;
+    // motion.program-paused (M00, M01 with the optional-stop switch, single block); read live.
+    std::optional<Probe> paused;
 };
 
 MachinePins find_pins(hal::Runtime& rt, const std::string& ini, const std::string& letters) {
@@ -215,7 +218,8 @@ MachinePins find_pins(hal::Runtime& rt, const std::string& ini, const std::strin
                   {},
                   {},
                   {},
-                  try_probe(rt, "interp.done")};
+                  try_probe(rt, "interp.done"),
+                  try_probe(rt, "motion.program-paused")};
     for (char l : letters) {
         if (auto probe = try_probe(rt, fmt::format("axis.{}.pos-cmd", l))) {
             p.letters += l;
@@ -399,7 +403,7 @@ class Trace {
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> file_;
 };
 
-enum class Outcome { Finished, Fault, Disabled, NeverEnabled, Timeout, Interrupted };
+enum class Outcome { Finished, Fault, Disabled, NeverEnabled, Timeout, Interrupted, PausedUnattended };
 
 // Why motion faulted, from the joint pins of the faulting cycle.
 // The first joint whose drive reports a fault, as text, or "". Read live: a drive whose
@@ -473,6 +477,23 @@ struct LoopResult {
     long samples = 0;
 };
 
+// A pause (motion.program-paused) is announced once; motion leaves it on a rising
+// motion.resume, which the operator gives with Enter, or --resume-pauses at once.
+struct PauseState {
+    bool operator_present = false;  // stdin is a terminal
+    bool announced = false;
+    bool resume_raised = false;
+};
+
+// Non-blocking: true once the operator has typed a line on the terminal.
+bool operator_pressed_enter() {
+    pollfd fd{STDIN_FILENO, POLLIN, 0};
+    if (::poll(&fd, 1, 0) != 1 || !(fd.revents & POLLIN)) return false;
+    char buffer[256];
+    const ssize_t n = ::read(STDIN_FILENO, buffer, sizeof buffer);
+    return n > 0 && std::memchr(buffer, '\n', static_cast<std::size_t>(n)) != nullptr;
+}
+
 // Steps the clock until the program ends or something stops it. `step` moves time on (one
 // servo period, or a poll interval of wall time) and returns the time since start.
 LoopResult watch(Session& session, const MachinePins& pins, const RunOptions& o,
@@ -482,6 +503,7 @@ LoopResult watch(Session& session, const MachinePins& pins, const RunOptions& o,
     Sample& s = r.last;
     bool ever_enabled = false;
     std::optional<double> abort_at_s;
+    PauseState pause{::isatty(STDIN_FILENO) == 1};
     for (;;) {
         next(s);
         ++r.samples;
@@ -518,6 +540,28 @@ LoopResult watch(Session& session, const MachinePins& pins, const RunOptions& o,
         if (!ever_enabled && s.t_s >= kEnableGraceS) {
             r.outcome = Outcome::NeverEnabled;
             return r;
+        }
+        if (pins.paused) {
+            if (pins.paused->bit()) {
+                if (!pause.announced) {
+                    pause.announced = true;
+                    if (!o.resume_pauses && !pause.operator_present) {
+                        r.outcome = Outcome::PausedUnattended;
+                        return r;
+                    }
+                    fmt::print(stderr, "{}{}:{}: program paused{}\n",
+                               ::isatty(STDOUT_FILENO) == 1 ? "\n" : "", o.program, s.line,
+                               o.resume_pauses ? "; resuming (--resume-pauses)"
+                                                : "; press Enter to resume");
+                }
+                if (!pause.resume_raised && (o.resume_pauses || operator_pressed_enter())) {
+                    session.exec({"setp", "motion.resume", "TRUE"});  // motion wants an edge
+                    pause.resume_raised = true;
+                }
+            } else if (pause.announced) {
+                if (pause.resume_raised) session.exec({"setp", "motion.resume", "FALSE"});
+                pause = PauseState{pause.operator_present};
+            }
         }
         if (s.in_position && s.program_done) return r;
         if (s.t_s >= o.timeout_s) {
@@ -714,6 +758,11 @@ std::string outcome_error(const RunOptions& o, const LoopResult& r) {
                                o.timeout_s);
         case Outcome::Interrupted:
             return fmt::format("{}: stopped on request (Ctrl-C or SIGTERM)", where);
+        case Outcome::PausedUnattended:
+            return fmt::format(
+                "{}: the program paused (M00, M01 or single block) and nothing can resume it: "
+                "standard input is not a terminal (run with --resume-pauses to go on at once)",
+                where);
     }
     return "";
 }
@@ -808,6 +857,9 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& o) {
                     "PNG or SVG picture of the path followed (top, front, side and isometric "
                     "views; feeds and rapids)")
         ->check(CLI::Validator(preview_path_error, "FILE.png|FILE.svg"));
+    cmd->add_flag("--resume-pauses", o.resume_pauses,
+                  "go on at once after M00, M01 or a single-block stop (otherwise Enter on a "
+                  "terminal resumes; without a terminal a pause is an error)");
     cmd->add_option("--timeout", o.timeout_s, "give up after this much motion time, s")
         ->check(CLI::PositiveNumber);
     return cmd;

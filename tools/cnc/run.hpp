@@ -16,6 +16,7 @@ struct RunOptions {
     std::string trace_path;    // empty: no trace
     std::string preview_path;  // empty: no picture
     bool sim_clock = false;
+    bool resume_pauses = false;  // M00/M01/single-block pauses resume at once
     double timeout_s = 3600;  // motion time (simulated under --sim-clock)
 };
 
