@@ -57,6 +57,12 @@ std::uint32_t ProgramFeeder::acknowledge(bool in_position) noexcept {
 }
 
 void ProgramFeeder::wait_for_lead() const noexcept {
+    // A ring at least half full already holds more than one period can use (a period would
+    // need records shorter than a 2000th of its travel each), so the period runs as it would
+    // with a full ring. Below that the ring is topped up completely: waiting every period for
+    // the one or two records it used cost more than the planning (surface programs ran at 2x
+    // real time).
+    if (ring_.size() >= ring_.capacity() / 2) return;
     // Also returns at a barrier motion has not reached yet (it must run there first); at one it
     // has acknowledged, it waits for the interpreter to go on, so the first period after a
     // queue-busting read is the same on every run.
