@@ -17,6 +17,8 @@ constexpr double kTangentEps = 1e-12;   // max per-axis tangent difference treat
 // The blend's largest distance from the programmed lines is (3/16) l sin(angle) (geometry.hpp).
 constexpr double kBlendDeviationPerL = 3.0 / 16.0;
 constexpr double kParabolaDeviationPerL = 1.0 / 4.0;
+// Turns sharper than this (about 170 degrees) between two lines are exact stops.
+constexpr double kReversalCos = -0.985;
 // A kink whose allowed speed is below this fraction of the feed is taken as an exact stop.
 constexpr double kKinkStopFraction = 0.02;
 // Jerk-limited elements share one S-curve profile when their limits are within this ratio.
@@ -149,6 +151,10 @@ Planner::Junction Planner::classify(const Piece& p, const Piece& next) const {
     bool lines = p.geom.kind == ElementKind::Line && next.geom.kind == ElementKind::Line;
     if (lines && p.tolerance_mm > 0) {
         double l = std::min(p.geom.length_mm, next.geom.length_mm) / 2;
+        // A (near) reversal stops at its end point: the axis passes through zero speed there
+        // anyway, so a blend saves almost nothing and would leave the bottom of a drilled
+        // hole sqrt(2) tol short (the miss every turn past 90 degrees is allowed, see above).
+        if (cos_angle < kReversalCos) return {0, false, 0};
         // Without a jerk limit the parabola (the per-axis bang-bang corner) is the fastest;
         // its distance from the lines is (l / 4) sin(angle) (geometry.hpp).
         if (!jerk_mode_) {

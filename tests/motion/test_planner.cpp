@@ -159,6 +159,39 @@ TEST(Planner, BlendedRightAngleIsTheParabolaWithoutJerkLimit) {
     EXPECT_NEAR(right_angle_deviation(recs[1]), tol, 1e-6);
 }
 
+// A peck-drill reversal (down to Z-6, straight back up) must reach Z-6: a blend there would
+// stay on the line, within any path tolerance, and still drill the hole short.
+TEST(Planner, ReversalIsAnExactStopAtItsEndPoint) {
+    for (double jerk : {0.0, 1e5}) {
+        PlannerConfig cfg = uniform(100, 1000, jerk);
+        auto recs = plan(cfg, {line_to({0, 0, -6}, 50, 0.05, 0), line_to({0, 0, -1}, 50, 0.05, 1)});
+        ASSERT_EQ(recs.size(), 2u) << "jerk " << jerk;
+        EXPECT_EQ(recs[0].geom.kind, ElementKind::Line);
+        EXPECT_NEAR(recs[0].geom.length_mm, 6, 1e-12) << "jerk " << jerk;
+        MotionSample end = sample(recs[0], recs[0].profile.duration_s);
+        EXPECT_NEAR(end.pos_mm[2], -6, 1e-12) << "jerk " << jerk;
+        EXPECT_NEAR(end.vel_mm_s[2], 0, 1e-9) << "jerk " << jerk;
+    }
+}
+
+// Past 90 degrees of turn the cut is l = tol / ((1/4) |T2 - T1| / sqrt(2)), so the parabola
+// misses the corner point by |T2 - T1| l / 4 = sqrt(2) tol, as at a right angle.
+TEST(Planner, SharpTurnBlendMissesTheCornerPointByNoMoreThanARightAngle) {
+    PlannerConfig cfg = uniform(100, 1000, 0);
+    const double tol = 0.01;
+    const double c = std::cos(2 * M_PI / 3), s = std::sin(2 * M_PI / 3);
+    auto recs = plan(cfg, {line_to({10}, 50, tol, 0), line_to({10 + 10 * c, 10 * s}, 50, tol, 1)});
+    ASSERT_EQ(recs.size(), 3u);
+    ASSERT_EQ(recs[1].geom.kind, ElementKind::Bezier);
+    const double dt = std::sqrt(2 - 2 * c);  // |T2 - T1|
+    const double l = 4 * tol * std::sqrt(2.0) / dt;
+    EXPECT_NEAR(recs[1].geom.length_mm, 2 * l, 1e-12);
+    // The parabola's middle is (P0 + 2 P1 + P2) / 4 with P1 the corner.
+    MotionSample mid = sample(recs[1], recs[1].profile.duration_s / 2);
+    const double miss = std::hypot(mid.pos_mm[0] - 10, mid.pos_mm[1]);
+    EXPECT_NEAR(miss, std::sqrt(2.0) * tol, 1e-6);
+}
+
 TEST(Planner, BlendedRightAngleIsTheQuarticWithJerkLimit) {
     PlannerConfig cfg = uniform(100, 1000, 1e9);  // a jerk limit too high to bind here
     const double tol = 0.01;
