@@ -10,10 +10,10 @@
 #include "run.hpp"
 
 #include <fmt/format.h>
+#include <poll.h>
 #include <pthread.h>
 #include <signal.h>
 #include <sys/mman.h>
-#include <poll.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -403,7 +403,15 @@ class Trace {
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> file_;
 };
 
-enum class Outcome { Finished, Fault, Disabled, NeverEnabled, Timeout, Interrupted, PausedUnattended };
+enum class Outcome {
+    Finished,
+    Fault,
+    Disabled,
+    NeverEnabled,
+    Timeout,
+    Interrupted,
+    PausedUnattended
+};
 
 // Why motion faulted, from the joint pins of the faulting cycle.
 // The first joint whose drive reports a fault, as text, or "". Read live: a drive whose
@@ -552,7 +560,7 @@ LoopResult watch(Session& session, const MachinePins& pins, const RunOptions& o,
                     fmt::print(stderr, "{}{}:{}: program paused{}\n",
                                ::isatty(STDOUT_FILENO) == 1 ? "\n" : "", o.program, s.line,
                                o.resume_pauses ? "; resuming (--resume-pauses)"
-                                                : "; press Enter to resume");
+                                               : "; press Enter to resume");
                 }
                 if (!pause.resume_raised && (o.resume_pauses || operator_pressed_enter())) {
                     session.exec({"setp", "motion.resume", "TRUE"});  // motion wants an edge
