@@ -82,8 +82,8 @@ struct SetRapidRate {  // NcStudio: F in a G00 block; 0 = the machine's maximum
 // blends with the machine's tolerance). Sent each time a program writes G61 or G64, and at
 // program end when the mode was not the default. Applies to the moves that follow.
 struct SetBlending {
-    bool exact = false;        // G61: every move ends exactly at its end point (exact path)
-    double tolerance_mm = 0;   // G64 P: allowed deviation at a blend; <= 0 = the machine default
+    bool exact = false;       // G61: every move ends exactly at its end point (exact path)
+    double tolerance_mm = 0;  // G64 P: allowed deviation at a blend; <= 0 = the machine default
 };
 struct SetFeedMode {  // only feed per minute exists in NcStudio; kept for the ISO dialect
     bool per_minute = true;
@@ -144,16 +144,20 @@ struct WaitInput {  // G906 PLC[a] LEVEL l P ms
     double timeout_s = 0;
 };
 struct Sync {};  // G906: wait until motion has finished and machine state is current
+// At namespace scope, not nested in ConditionalMove: clang decides whether a nested class with
+// default member initializers is default-constructible before it has read them, so
+// std::optional<AxisWatch>::emplace() would not compile there.
+struct ConditionalAxisWatch {
+    int axis = 0;
+    double speed_mm_s = 0;
+    int port = 0;
+    bool level = false;
+    std::optional<double> max_travel_mm;
+};
 // G904: each listed axis moves at its signed speed until its input reaches the level or it has
 // travelled max_travel_mm (no limit when absent).
 struct ConditionalMove {
-    struct AxisWatch {
-        int axis = 0;
-        double speed_mm_s = 0;
-        int port = 0;
-        bool level = false;
-        std::optional<double> max_travel_mm;
-    };
+    using AxisWatch = ConditionalAxisWatch;
     std::array<std::optional<AxisWatch>, 3> axes;
     MoveFlags flags;
 };

@@ -349,7 +349,8 @@ template <std::size_t... I>
 bool decode_command(std::size_t index, const Record& r, std::string_view text, CanonCommand& out,
                     std::index_sequence<I...>) {
     bool done = false;
-    ((I == index ? (done = decode_alternative<I>(r, text, out), true) : false) || ...);
+    static_cast<void>(
+        ((I == index ? (done = decode_alternative<I>(r, text, out), true) : false) || ...));
     return done;
 }
 
