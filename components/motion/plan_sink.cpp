@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <variant>
 
+#include "canon_geometry.hpp"
 #include "interp/canon.hpp"
 #include "program_feeder.hpp"
 
@@ -61,13 +62,7 @@ class PlanSink final : public interp::CanonSink {
     }
     void handle(const interp::SourceLoc& loc, const interp::canon::Arc& a) {
         motion::PathSegment seg = base_segment(loc, a.end_mm, a.flags);
-        seg.kind = motion::SegmentKind::Arc;
-        const interp::PlaneAxes axes = interp::plane_axes(a.plane);
-        seg.plane_first = axes.first;
-        seg.plane_second = axes.second;
-        seg.plane_normal = axes.normal;
-        seg.centre_mm = {a.centre_mm[axes.first], a.centre_mm[axes.second]};
-        seg.turns = a.turns;
+        motioncomp::set_arc_geometry(seg, a);
         seg.feed_mm_s = feed_mm_s_;
         push(loc, seg);
     }

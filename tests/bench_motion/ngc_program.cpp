@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <variant>
 
+#include "canon_geometry.hpp"
 #include "interp/canon.hpp"
 #include "interp/executor.hpp"
 #include "interp/interpreter.hpp"
@@ -44,13 +45,7 @@ class SegmentSink final : public interp::CanonSink {
     }
     void handle(const interp::SourceLoc& loc, const interp::canon::Arc& a) {
         PathSegment seg = base(loc, a.end_mm, a.flags);
-        seg.kind = SegmentKind::Arc;
-        const interp::PlaneAxes axes = interp::plane_axes(a.plane);
-        seg.plane_first = axes.first;
-        seg.plane_second = axes.second;
-        seg.plane_normal = axes.normal;
-        seg.centre_mm = {a.centre_mm[axes.first], a.centre_mm[axes.second]};
-        seg.turns = a.turns;
+        motioncomp::set_arc_geometry(seg, a);
         seg.feed_mm_s = feed_mm_s_;
         add(seg);
     }
