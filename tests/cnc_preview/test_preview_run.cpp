@@ -14,22 +14,8 @@ namespace {
 using namespace preview_test;
 using cncrun::View;
 
-struct RunResult {
-    int exit_code = -1;
-    std::string out, err;
-};
-
-RunResult run_cnc(const std::string& args, const fs::path& scratch) {
-    const fs::path out = scratch / "stdout.txt", err = scratch / "stderr.txt";
-    const std::string cmd = fmt::format("cd '{}' && '{}' run {} > '{}' 2> '{}'", CNC_SOURCE_DIR,
-                                        CNC_BIN, args, out.string(), err.string());
-    const int status = std::system(cmd.c_str());
-    RunResult r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-}
+using cnc_test::run_cnc;
+using cnc_test::RunResult;
 
 TEST(PreviewRun, PocketPngShowsTheOutlineInTheTopView) {
     ScratchDir dir;

@@ -13,52 +13,16 @@
 #include <string>
 #include <vector>
 
+#include "cnc_run_harness.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct RunResult {
-    int exit_code = -1;
-    std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-// A scratch folder of this test's own, so tests run in parallel.
-class ScratchDir {
-  public:
-    ScratchDir() {
-        std::string tmpl = (fs::temp_directory_path() / "cnc_run_test.XXXXXX").string();
-        if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
-        path_ = tmpl;
-    }
-    ~ScratchDir() {
-        std::error_code ec;
-        fs::remove_all(path_, ec);
-    }
-    const fs::path& path() const { return path_; }
-
-  private:
-    fs::path path_;
-};
-
-RunResult run_cnc(const std::string& args, const fs::path& scratch,
-                  const fs::path& cwd = CNC_SOURCE_DIR) {
-    const fs::path out = scratch / "stdout.txt", err = scratch / "stderr.txt";
-    const std::string cmd = fmt::format("cd '{}' && '{}' run {} > '{}' 2> '{}'", cwd.string(),
-                                        CNC_BIN, args, out.string(), err.string());
-    const int status = std::system(cmd.c_str());
-    RunResult r;
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-}
+using cnc_test::run_cnc;
+using cnc_test::RunResult;
+using cnc_test::ScratchDir;
+using cnc_test::slurp;
 
 // The text after "KEY: " on the summary line that starts with KEY, or "".
 std::string summary_field(const std::string& out, const std::string& key) {
@@ -280,13 +244,13 @@ TEST(CncRunErrors, MoveBeyondTheIniSoftLimitIsRefused) {
     ScratchDir scratch;
     const fs::path high = scratch.path() / "high.ngc";
     std::ofstream(high) << "G90 G21\nG01 X10 F600\nG00 Z5\nM30\n";
-    const RunResult r = run_cnc(
-        fmt::format("configs/sim/mill.ini '{}' --sim-clock", high.string()), scratch.path());
+    const RunResult r = run_cnc(fmt::format("configs/sim/mill.ini '{}' --sim-clock", high.string()),
+                                scratch.path());
     EXPECT_EQ(r.exit_code, 1);
-    EXPECT_NE(r.err.find(high.string() +
-                         ":3:1: the move takes Z to 5 mm, which exceeds the soft limit "
-                         "axis.z.max-limit = 0 mm"),
-              std::string::npos)
+    EXPECT_NE(
+        r.err.find(high.string() + ":3:1: the move takes Z to 5 mm, which exceeds the soft limit "
+                                   "axis.z.max-limit = 0 mm"),
+        std::string::npos)
         << r.err;
 }
 
@@ -296,8 +260,8 @@ TEST(CncRunErrors, G906TimeoutNamesTheProgramFileAndLine) {
     ScratchDir scratch;
     const fs::path wait = scratch.path() / "wait.ngc";
     std::ofstream(wait) << "G90 G21\nG1 X10 F6000\nG906 PLC[0] LEVEL1 P500\nG1 X20\nM30\n";
-    const RunResult r = run_cnc(
-        fmt::format("configs/sim/mill.ini '{}' --sim-clock", wait.string()), scratch.path());
+    const RunResult r = run_cnc(fmt::format("configs/sim/mill.ini '{}' --sim-clock", wait.string()),
+                                scratch.path());
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.err.find(wait.string() +
                          ":3: G906: motion.digital-in-00 did not become TRUE within 0.5 s"),
@@ -310,9 +274,9 @@ TEST(CncRunPause, M00WithoutATerminalIsAnErrorAtItsLine) {
     ScratchDir scratch;
     const fs::path prog = scratch.path() / "m00.ngc";
     std::ofstream(prog) << "G90 G21\nG1 X10 F600\nM00\nG1 X20\nM30\n";
-    const RunResult r = run_cnc(
-        fmt::format("configs/sim/mill.ini '{}' --sim-clock < /dev/null", prog.string()),
-        scratch.path());
+    const RunResult r =
+        run_cnc(fmt::format("configs/sim/mill.ini '{}' --sim-clock < /dev/null", prog.string()),
+                scratch.path());
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.err.find(prog.string() + ":3: the program paused"), std::string::npos) << r.err;
     EXPECT_NE(r.out.find("final position (mm): x 10.0000"), std::string::npos) << r.out;
@@ -322,10 +286,10 @@ TEST(CncRunPause, ResumePausesGoesOnAfterM00) {
     ScratchDir scratch;
     const fs::path prog = scratch.path() / "m00.ngc";
     std::ofstream(prog) << "G90 G21\nG1 X10 F600\nM00\nG1 X20\nM30\n";
-    const RunResult r = run_cnc(
-        fmt::format("configs/sim/mill.ini '{}' --sim-clock --resume-pauses < /dev/null",
-                    prog.string()),
-        scratch.path());
+    const RunResult r =
+        run_cnc(fmt::format("configs/sim/mill.ini '{}' --sim-clock --resume-pauses < /dev/null",
+                            prog.string()),
+                scratch.path());
     EXPECT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.err.find(prog.string() + ":3: program paused; resuming"), std::string::npos)
         << r.err;
@@ -616,9 +580,10 @@ TEST(CncRunInterp, QueueBustingReadsWaitForTheMachineAndRunTheSameEveryTime) {
     std::string outs[2], traces[2];
     for (int i = 0; i < 2; ++i) {
         const fs::path csv = scratch.path() / fmt::format("t{}.csv", i);
-        const RunResult r = run_cnc(fmt::format("configs/sim/mill.ini '{}' --sim-clock --trace '{}'",
-                                                prog.string(), csv.string()),
-                                    scratch.path());
+        const RunResult r =
+            run_cnc(fmt::format("configs/sim/mill.ini '{}' --sim-clock --trace '{}'", prog.string(),
+                                csv.string()),
+                    scratch.path());
         ASSERT_EQ(r.exit_code, 0) << r.err;
         outs[i] = r.out;
         traces[i] = slurp(csv);

@@ -59,6 +59,26 @@ double rays_distance(const AxisArray& p, const AxisArray& corner, const AxisArra
     return std::min(ray(t1, -1), ray(t2, 1));
 }
 
+// A random corner in four axes: unit tangents in and out, a corner point, a blend length.
+struct RandomCorner {
+    AxisArray t1{}, t2{}, corner{};
+    double l = 0;
+    double dt2 = 0;  // |T2 - T1|^2
+};
+RandomCorner random_corner(std::mt19937_64& rng) {
+    std::normal_distribution<double> n(0, 1);
+    RandomCorner c;
+    double n1 = 0, n2 = 0;
+    for (int k = 0; k < 4; ++k) {
+        c.t1[k] = n(rng), c.t2[k] = n(rng), c.corner[k] = 10 * n(rng);
+        n1 += c.t1[k] * c.t1[k], n2 += c.t2[k] * c.t2[k];
+    }
+    for (int k = 0; k < 4; ++k) c.t1[k] /= std::sqrt(n1), c.t2[k] /= std::sqrt(n2);
+    c.l = 0.05 + std::fabs(n(rng));
+    for (int k = 0; k < kAxes; ++k) c.dt2 += (c.t2[k] - c.t1[k]) * (c.t2[k] - c.t1[k]);
+    return c;
+}
+
 TEST(Geometry, QuarterArcG17HasRightLengthEndsAndUnitSpeed) {
     PathSegment seg;
     seg.kind = SegmentKind::Arc;
@@ -141,24 +161,16 @@ TEST(Geometry, SmallEndRoundingMovesTheCentreOntoTheBisector) {
 
 TEST(Geometry, BlendStaysWithinItsDeviationAndJoinsTangentially) {
     std::mt19937_64 rng(3);
-    std::normal_distribution<double> n(0, 1);
     for (int trial = 0; trial < 500; ++trial) {
-        AxisArray t1{}, t2{}, corner{};
-        double n1 = 0, n2 = 0;
-        for (int k = 0; k < 4; ++k) {
-            t1[k] = n(rng), t2[k] = n(rng), corner[k] = 10 * n(rng);
-            n1 += t1[k] * t1[k], n2 += t2[k] * t2[k];
-        }
-        for (int k = 0; k < 4; ++k) t1[k] /= std::sqrt(n1), t2[k] /= std::sqrt(n2);
-        double l = 0.05 + std::fabs(n(rng));
+        const RandomCorner c = random_corner(rng);
+        const AxisArray &t1 = c.t1, &t2 = c.t2, &corner = c.corner;
+        const double l = c.l;
         Element b = make_blend(corner, t1, t2, l);
         check_derivatives(b);
-        double dt = 0;
-        for (int k = 0; k < kAxes; ++k) dt += (t2[k] - t1[k]) * (t2[k] - t1[k]);
-        double max_dev = 3.0 / 16.0 * l * std::sqrt(dt);
+        double max_dev = 3.0 / 16.0 * l * std::sqrt(c.dt2);
         // What the planner relies on: the distance from the path is at most (3/16) l sin(angle)
         // up to 90 degrees and (3/16) l |T2 - T1| / sqrt(2) beyond.
-        double path_dev = 3.0 / 16.0 * l * corner_sine(dt);
+        double path_dev = 3.0 / 16.0 * l * corner_sine(c.dt2);
         EndDerivs s = start_derivs(b), e = end_derivs(b);
         for (int k = 0; k < kAxes; ++k) {
             EXPECT_NEAR(s.tangent[k], t1[k], 1e-12);
@@ -169,17 +181,7 @@ TEST(Geometry, BlendStaysWithinItsDeviationAndJoinsTangentially) {
         for (int i = 0; i <= 100; ++i) {
             CurvePoint cp;
             evaluate(b, b.length_mm * i / 100, cp);
-            // distance to the two corner rays
-            auto ray = [&](const AxisArray& t, double sign) {
-                double along = 0;
-                for (int k = 0; k < kAxes; ++k) along += (cp.p[k] - corner[k]) * t[k] * sign;
-                along = std::max(0.0, along);
-                AxisArray foot;
-                for (int k = 0; k < kAxes; ++k) foot[k] = corner[k] + sign * along * t[k];
-                return dist(cp.p, foot);
-            };
-            double d = std::min(ray(t1, -1), ray(t2, 1));
-            ASSERT_LE(d, path_dev + 1e-12);
+            ASSERT_LE(rays_distance(cp.p, corner, t1, t2), path_dev + 1e-12);
             double speed = 0;
             for (double x : cp.d1) speed += x * x;
             ASSERT_LE(std::sqrt(speed), 1 + 1e-12);
@@ -193,21 +195,13 @@ TEST(Geometry, BlendStaysWithinItsDeviationAndJoinsTangentially) {
 // The planner's corner without a jerk limit: a cubic with the parabola's control points.
 TEST(Geometry, ParabolicBezierBlendStaysWithinQuarterLSineAndHasUnitEndSpeed) {
     std::mt19937_64 rng(5);
-    std::normal_distribution<double> n(0, 1);
     for (int trial = 0; trial < 500; ++trial) {
-        AxisArray t1{}, t2{}, corner{};
-        double n1 = 0, n2 = 0;
-        for (int k = 0; k < 4; ++k) {
-            t1[k] = n(rng), t2[k] = n(rng), corner[k] = 10 * n(rng);
-            n1 += t1[k] * t1[k], n2 += t2[k] * t2[k];
-        }
-        for (int k = 0; k < 4; ++k) t1[k] /= std::sqrt(n1), t2[k] /= std::sqrt(n2);
-        double l = 0.05 + std::fabs(n(rng));
+        const RandomCorner c = random_corner(rng);
+        const AxisArray &t1 = c.t1, &t2 = c.t2, &corner = c.corner;
+        const double l = c.l, dt = c.dt2;
         Element b = make_parabola(corner, t1, t2, l);
         EXPECT_NEAR(b.length_mm, 2 * l, 1e-12);
         check_derivatives(b);
-        double dt = 0;
-        for (int k = 0; k < kAxes; ++k) dt += (t2[k] - t1[k]) * (t2[k] - t1[k]);
         EndDerivs s = start_derivs(b), e = end_derivs(b);
         for (int k = 0; k < kAxes; ++k) {
             EXPECT_NEAR(s.tangent[k], t1[k], 1e-12);

@@ -1,0 +1,67 @@
+// Runs the `cnc` command from tests: a scratch folder per test (so tests run in parallel under
+// ctest -j), the whole of a file, and `cnc run ARGS` with its exit status and output.
+// The including target defines CNC_BIN (the cnc executable) and CNC_SOURCE_DIR (the repo root,
+// where the arguments' relative paths start).
+#pragma once
+
+#include <fmt/format.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+namespace cnc_test {
+
+namespace fs = std::filesystem;
+
+class ScratchDir {
+  public:
+    ScratchDir() {
+        std::string tmpl = (fs::temp_directory_path() / "cnc_test.XXXXXX").string();
+        if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
+        path_ = tmpl;
+    }
+    ~ScratchDir() {
+        std::error_code ec;
+        fs::remove_all(path_, ec);
+    }
+    ScratchDir(const ScratchDir&) = delete;
+    ScratchDir& operator=(const ScratchDir&) = delete;
+    const fs::path& path() const { return path_; }
+
+  private:
+    fs::path path_;
+};
+
+inline std::string slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+struct RunResult {
+    int exit_code = -1;
+    std::string out, err;
+};
+
+// `cnc run ARGS` in `cwd`; stdout and stderr go through files in `scratch`.
+inline RunResult run_cnc(const std::string& args, const fs::path& scratch,
+                         const fs::path& cwd = CNC_SOURCE_DIR) {
+    const fs::path out = scratch / "stdout.txt", err = scratch / "stderr.txt";
+    const std::string cmd = fmt::format("cd '{}' && '{}' run {} > '{}' 2> '{}'", cwd.string(),
+                                        CNC_BIN, args, out.string(), err.string());
+    const int status = std::system(cmd.c_str());
+    RunResult r;
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+}
+
+}  // namespace cnc_test
