@@ -79,22 +79,13 @@ ProgramRunner::~ProgramRunner() {
 }
 
 bool ProgramRunner::start_and_wait_ready() {
-    if (thread_.joinable() || done() || failed()) return failed();
-    pause_.store(false, std::memory_order_relaxed);
-    {
-        std::lock_guard lock(mutex_);
-        ready_ = false;
-    }
+    if (worker_.running() || done() || failed()) return failed();
     running_.store(true, std::memory_order_relaxed);
-    thread_ = std::thread([this] { run(); });
-    std::unique_lock lock(mutex_);
-    ready_cv_.wait(lock, [this] { return ready_; });
-    return failed_at_ready_;
+    return worker_.start_and_wait_ready([this] { run(); });
 }
 
 void ProgramRunner::stop() {
-    pause_.store(true, std::memory_order_relaxed);
-    if (thread_.joinable()) thread_.join();
+    worker_.pause_and_join();
     running_.store(false, std::memory_order_relaxed);
 }
 
@@ -110,15 +101,11 @@ std::string ProgramRunner::where() const {
 
 bool ProgramRunner::stopping() noexcept {
     if (link_.abort_requested()) abort_.store(true, std::memory_order_relaxed);
-    return pause_.load(std::memory_order_relaxed) || abort_.load(std::memory_order_relaxed);
+    return worker_.pause_requested() || abort_.load(std::memory_order_relaxed);
 }
 
 void ProgramRunner::mark_ready() {
-    std::lock_guard lock(mutex_);
-    if (ready_) return;
-    ready_ = true;
-    failed_at_ready_ = failed();
-    ready_cv_.notify_all();
+    worker_.mark_ready(failed());
 }
 
 void ProgramRunner::send(const interp::Canon& c) {
@@ -194,7 +181,7 @@ void ProgramRunner::run() noexcept {
             finish(e.what());
         }
     }
-    while (!pause_.load(std::memory_order_relaxed)) {
+    while (!worker_.pause_requested()) {
         const bool all_sent = deliver();
         if (finished_ && all_sent) break;
         if (!all_sent) mark_ready();  // the stream is full
@@ -204,7 +191,7 @@ void ProgramRunner::run() noexcept {
         }
         link_.on_progress();
         if (stopping()) {
-            if (pause_.load(std::memory_order_relaxed)) break;
+            if (worker_.pause_requested()) break;
             finish(fmt::format("{}: aborted; the rest of the program is given up", where()));
             continue;
         }

@@ -6,14 +6,13 @@
 #pragma once
 
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <memory>
 #include <mutex>
 #include <string>
-#include <thread>
 
+#include "hal/worker.hpp"
 #include "interp/canon_wire.hpp"
 
 namespace interp {
@@ -110,8 +109,6 @@ class ProgramRunner {
     bool finished_ = false;  // the end record is in the outbox
     bool current_ = false;
 
-    std::thread thread_;
-    std::atomic<bool> pause_{false};
     std::atomic<bool> abort_{false};
     std::atomic<bool> done_{false};
     std::atomic<bool> failed_{false};
@@ -121,10 +118,8 @@ class ProgramRunner {
     std::atomic<std::uint32_t> barriers_{0};
 
     mutable std::mutex mutex_;
-    std::condition_variable ready_cv_;
-    bool ready_ = false;
-    bool failed_at_ready_ = false;
     std::string error_;
+    hal::Worker worker_;  // last: joins the thread before the state it uses goes
 };
 
 }  // namespace interpcomp

@@ -27,21 +27,12 @@ ProgramFeeder::~ProgramFeeder() {
 }
 
 bool ProgramFeeder::start_and_wait_ready() {
-    if (thread_.joinable() || idle_.load(std::memory_order_acquire)) return false;
-    pause_.store(false, std::memory_order_relaxed);
-    {
-        std::lock_guard lock(mutex_);
-        ready_ = false;
-    }
-    thread_ = std::thread([this] { run(); });
-    std::unique_lock lock(mutex_);
-    ready_cv_.wait(lock, [this] { return ready_; });
-    return failed_at_ready_;
+    if (worker_.running() || idle_.load(std::memory_order_acquire)) return false;
+    return worker_.start_and_wait_ready([this] { run(); });
 }
 
 void ProgramFeeder::stop() {
-    pause_.store(true, std::memory_order_relaxed);
-    if (thread_.joinable()) thread_.join();
+    worker_.pause_and_join();
 }
 
 bool ProgramFeeder::idle() const noexcept {
@@ -92,15 +83,11 @@ std::string ProgramFeeder::error() const {
 }
 
 void ProgramFeeder::mark_ready() {
-    std::lock_guard lock(mutex_);
-    if (ready_) return;
-    ready_ = true;
-    failed_at_ready_ = failed();
-    ready_cv_.notify_all();
+    worker_.mark_ready(failed());
 }
 
 bool ProgramFeeder::stopping() const noexcept {
-    return pause_.load(std::memory_order_relaxed) || abandoned_.load(std::memory_order_relaxed);
+    return worker_.pause_requested() || abandoned_.load(std::memory_order_relaxed);
 }
 
 void ProgramFeeder::collect(const motion::PreparedSegment* extra) {

@@ -13,7 +13,6 @@
 
 #include <array>
 #include <atomic>
-#include <condition_variable>
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -21,8 +20,8 @@
 #include <mutex>
 #include <string>
 #include <string_view>
-#include <thread>
 
+#include "hal/worker.hpp"
 #include "interp/canon_wire.hpp"
 #include "motion/planner.hpp"
 #include "motion/prepared.hpp"
@@ -106,6 +105,7 @@ class ProgramFeeder {
     void deliver() noexcept;  // outbox -> ring, as far as it fits
     void fail(const std::string& message);
     void mark_ready();
+    void remember_stream_file(std::string_view file);
 
     FeederConfig cfg_;
     motion::SpscRing<motion::PreparedSegment>& ring_;
@@ -116,11 +116,9 @@ class ProgramFeeder {
     std::unique_ptr<interp::Executor> executor_;
     std::unique_ptr<interp::Interpreter> interpreter_;
     std::unique_ptr<interp::wire::Decoder> decoder_;  // stream mode
-    std::deque<motion::PreparedSegment> outbox_;  // planned, in order, not yet in the ring
-    bool program_done_ = false;                   // interpreter ended (or failed), planner finished
+    std::deque<motion::PreparedSegment> outbox_;      // planned, in order, not yet in the ring
+    bool program_done_ = false;  // interpreter ended (or failed), planner finished
 
-    std::thread thread_;
-    std::atomic<bool> pause_{false};
     std::atomic<bool> abandoned_{false};
     std::atomic<bool> idle_{false};
     std::atomic<bool> failed_{false};
@@ -136,13 +134,10 @@ class ProgramFeeder {
     std::uint32_t acknowledged_ = 0;                // servo thread only
 
     mutable std::mutex mutex_;
-    std::condition_variable ready_cv_;
-    bool ready_ = false;
-    bool failed_at_ready_ = false;
     std::string error_;
     std::string stream_file_;         // guarded by mutex_
     bool stream_file_known_ = false;  // feeder thread only
-    void remember_stream_file(std::string_view file);
+    hal::Worker worker_;              // last: joins the thread before the state it uses goes
 };
 
 // A record that holds `pos_mm` for `seconds` (a dwell), ending at rest like a program end.
