@@ -47,30 +47,6 @@
 
 namespace {
 
-// An input pin whose own storage the component may write. Reads follow the linked signal when
-// there is one; writes always go to the pin's own storage, which is what an unlinked pin reads.
-template <class T>
-class SelfWritableIn {
-  public:
-    SelfWritableIn(hal::Instance* owner, std::string_view name, T initial = T{}) {
-        own_ = static_cast<T*>(hal::detail::register_pin(*owner, name, hal::TypeOf<T>::value,
-                                                         hal::Dir::In,
-                                                         hal::detail::to_value(initial), &ptr_));
-        ptr_ = own_;
-    }
-    SelfWritableIn(const SelfWritableIn&) = delete;
-    SelfWritableIn& operator=(const SelfWritableIn&) = delete;
-    T get() const noexcept {
-        return hal::detail::load(std::atomic_ref<T*>(ptr_).load(std::memory_order_relaxed));
-    }
-    operator T() const noexcept { return get(); }
-    void set_own(T v) noexcept { hal::detail::store(own_, v); }
-
-  private:
-    mutable T* ptr_;  // retargeted by the runtime when the pin is linked or unlinked
-    T* own_;
-};
-
 double clamp_symmetric(double value, double limit) noexcept {
     if (limit == 0.0) return value;  // 0 means "no limit" for every max* pin
     if (value > limit) return limit;
@@ -89,20 +65,20 @@ enum class TuneState { Pid, Idle, Start, Positive, Negative, Abort };
 struct Pid : hal::Instance {
     hal::In<bool> enable{this, "enable"};
     hal::In<double> command{this, "command"};
-    SelfWritableIn<double> command_deriv{this, "command-deriv"};
+    hal::SelfWritableIn<double> command_deriv{this, "command-deriv"};
     hal::In<double> feedback{this, "feedback"};
-    SelfWritableIn<double> feedback_deriv{this, "feedback-deriv"};
+    hal::SelfWritableIn<double> feedback_deriv{this, "feedback-deriv"};
     hal::Out<double> error{this, "error"};
     hal::Out<double> output{this, "output"};
     hal::Out<bool> saturated{this, "saturated"};
     hal::Out<double> saturated_s{this, "saturated-s"};
     hal::Out<std::int32_t> saturated_count{this, "saturated-count"};
-    SelfWritableIn<double> pgain{this, "Pgain", 1.0};
-    SelfWritableIn<double> igain{this, "Igain"};
-    SelfWritableIn<double> dgain{this, "Dgain"};
-    SelfWritableIn<double> ff0{this, "FF0"};
-    SelfWritableIn<double> ff1{this, "FF1"};
-    SelfWritableIn<double> ff2{this, "FF2"};
+    hal::SelfWritableIn<double> pgain{this, "Pgain", 1.0};
+    hal::SelfWritableIn<double> igain{this, "Igain"};
+    hal::SelfWritableIn<double> dgain{this, "Dgain"};
+    hal::SelfWritableIn<double> ff0{this, "FF0"};
+    hal::SelfWritableIn<double> ff1{this, "FF1"};
+    hal::SelfWritableIn<double> ff2{this, "FF2"};
     hal::In<double> ff3{this, "FF3"};
     hal::In<double> deadband{this, "deadband"};
     hal::In<double> maxerror{this, "maxerror"};

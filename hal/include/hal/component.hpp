@@ -177,6 +177,29 @@ private:
     mutable T* ptr_;  // retargeted by the runtime when the pin is linked or unlinked
 };
 
+// An input pin whose own storage the component may also write (LinuxCNC's pid computes its
+// command-deriv when nothing drives it, and writes back tuned gains). Reads follow the linked
+// signal when there is one; set_own() always writes the pin's own storage, which is what an
+// unlinked pin reads, so a signal's value is never overwritten by a reader.
+template <class T>
+class SelfWritableIn {
+public:
+    SelfWritableIn(Instance* owner, std::string_view name, T initial = T{}) {
+        own_ = static_cast<T*>(detail::register_pin(*owner, name, TypeOf<T>::value, Dir::In,
+                                                    detail::to_value(initial), &ptr_));
+        ptr_ = own_;
+    }
+    SelfWritableIn(const SelfWritableIn&) = delete;
+    SelfWritableIn& operator=(const SelfWritableIn&) = delete;
+    T get() const noexcept { return detail::load(std::atomic_ref<T*>(ptr_).load(std::memory_order_relaxed)); }
+    operator T() const noexcept { return get(); }
+    void set_own(T v) noexcept { detail::store(own_, v); }
+
+private:
+    mutable T* ptr_;  // retargeted by the runtime when the pin is linked or unlinked
+    T* own_;
+};
+
 template <class T>
 class Out {
 public:
