@@ -31,12 +31,23 @@ class CoreXYWithExtras final : public motion::Kinematics {
     std::vector<int> axes_;
 };
 
+class CoreXYSource final : public motion::KinematicsSource {
+  public:
+    explicit CoreXYSource(int joints) : joints_(joints) {}
+    std::unique_ptr<motion::Kinematics> make() const override {
+        return std::make_unique<CoreXYWithExtras>(joints_);
+    }
+
+  private:
+    int joints_;
+};
+
 struct KinsCoreXY : kins::KinsInstance {
     KinsCoreXY() {
         const long joints = arg_int("joints", 3);
         if (joints < 3 || joints > motion::kAxes)
             throw hal::Error("joints=" + std::to_string(joints) + ": give 3 to 9 joints");
-        build(std::make_unique<CoreXYWithExtras>(static_cast<int>(joints)));
+        build(std::make_shared<CoreXYSource>(static_cast<int>(joints)));
     }
 };
 
@@ -45,3 +56,4 @@ struct KinsCoreXY : kins::KinsInstance {
 HAL_COMPONENT(kins_corexy, KinsCoreXY,
               "CoreXY kinematics: joint 0 = X + Y, joint 1 = X - Y, joint 2 = Z, joints 3-8 A..W",
               "joints")
+KINS_MODULE(kins_corexy)

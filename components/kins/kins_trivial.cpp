@@ -8,11 +8,22 @@
 
 namespace {
 
+class TrivialSource final : public motion::KinematicsSource {
+  public:
+    explicit TrivialSource(std::string coordinates) : coordinates_(std::move(coordinates)) {}
+    std::unique_ptr<motion::Kinematics> make() const override {
+        return std::make_unique<motion::TrivialKinematics>(coordinates_);
+    }
+
+  private:
+    std::string coordinates_;
+};
+
 struct KinsTrivial : kins::KinsInstance {
     KinsTrivial() {
         const std::string coordinates = arg("coordinates").value_or("XYZABCUVW");
         try {
-            build(std::make_unique<motion::TrivialKinematics>(coordinates));
+            build(std::make_shared<TrivialSource>(coordinates));
         } catch (const std::invalid_argument& e) {
             throw hal::Error(e.what());
         }
@@ -25,3 +36,4 @@ HAL_COMPONENT(kins_trivial, KinsTrivial,
               "Trivial kinematics: joint N follows the N-th letter of coordinates= (gantry: a "
               "letter twice)",
               "coordinates")
+KINS_MODULE(kins_trivial)

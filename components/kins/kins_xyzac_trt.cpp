@@ -8,40 +8,55 @@
 //   x-rot-point, y-rot-point   where the C axis crosses the XY plane (at A = 0)
 //   y-offset                   the A axis lies y-offset from y-rot-point in Y ...
 //   z-rot-point + z-offset     ... and at this Z
-//   tool-offset                tool length: the A axis is this much further from the tip
+//   tool-offset                tool length (net motion.tooloffset.z to it, as LinuxCNC
+//                              configs do): the program's Z includes it (G43), and adding it
+//                              to the A pivot makes the tool tip, not the spindle nose,
+//                              follow the path when A tilts (see motion/kinematics.hpp)
 //   x-offset                   unused by XYZAC (LinuxCNC's XYZBC needs it); kept for porting
 // LinuxCNC's formulas equal motion::XyzacTrtKinematics with c_pivot = (x-rot-point,
 // y-rot-point) and a_pivot = (y-rot-point + y-offset, z-rot-point + z-offset + tool-offset),
-// rotations right-handed in both. They are read every cycle, so motion may feed tool-offset.
+// rotations right-handed in both. They are read every cycle, so tool-offset follows G43/G49 as the
+// program runs.
 #include "kins_common.hpp"
 
 namespace {
 
-struct KinsXyzacTrt : kins::KinsInstance {
-    hal::In<double> x_rot_point{this, "x-rot-point"};
-    hal::In<double> y_rot_point{this, "y-rot-point"};
-    hal::In<double> z_rot_point{this, "z-rot-point"};
-    hal::In<double> x_offset{this, "x-offset"};
-    hal::In<double> y_offset{this, "y-offset"};
-    hal::In<double> z_offset{this, "z-offset"};
-    hal::In<double> tool_offset{this, "tool-offset"};
-    motion::XyzacTrtKinematics* trt_ = nullptr;  // owned by the base
+// The geometry pins; shared with the motion component through the registry, so they are
+// members of the source rather than of the instance.
+class TrtSource final : public motion::KinematicsSource {
+  public:
+    explicit TrtSource(hal::Instance* owner)
+        : x_rot_point_(owner, "x-rot-point"),
+          y_rot_point_(owner, "y-rot-point"),
+          z_rot_point_(owner, "z-rot-point"),
+          x_offset_(owner, "x-offset"),
+          y_offset_(owner, "y-offset"),
+          z_offset_(owner, "z-offset"),
+          tool_offset_(owner, "tool-offset") {}
 
-    KinsXyzacTrt() {
-        auto k = std::make_unique<motion::XyzacTrtKinematics>(motion::TrtPivots{});
-        trt_ = k.get();
-        build(std::move(k));
+    std::unique_ptr<motion::Kinematics> make() const override {
+        return std::make_unique<motion::XyzacTrtKinematics>(motion::TrtPivots{});
     }
 
-    void refresh() noexcept override {
+  private:
+    void copy_params(motion::Kinematics& k) const noexcept override {
         motion::TrtPivots p;
-        p.c_pivot_mm = {x_rot_point, y_rot_point, 0.0};
-        p.a_pivot_mm = {0.0, y_rot_point + y_offset, z_rot_point + z_offset + tool_offset};
-        trt_->set_pivots(p);
+        p.c_pivot_mm = {x_rot_point_, y_rot_point_, 0.0};
+        p.a_pivot_mm = {0.0, y_rot_point_ + y_offset_, z_rot_point_ + z_offset_ + tool_offset_};
+        static_cast<motion::XyzacTrtKinematics&>(k).set_pivots(p);  // k came from make()
     }
+
+    hal::In<double> x_rot_point_, y_rot_point_, z_rot_point_;
+    hal::In<double> x_offset_, y_offset_, z_offset_;
+    hal::In<double> tool_offset_;
+};
+
+struct KinsXyzacTrt : kins::KinsInstance {
+    KinsXyzacTrt() { build(std::make_shared<TrtSource>(this)); }
 };
 
 }  // namespace
 
 HAL_COMPONENT(kins_xyzac_trt, KinsXyzacTrt,
               "Five-axis table-tilting kinematics (A on X, C on Z), LinuxCNC xyzac-trt-kins pins")
+KINS_MODULE(kins_xyzac_trt)

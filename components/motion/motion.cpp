@@ -6,9 +6,11 @@
 // action records in the same ring, in program order, and are carried out here on the pins
 // LinuxCNC's motion and iocontrol publish (spindle.0.*, iocontrol.0.*, motion.digital-*).
 //
-// Kinematics inside this component are trivial (joint N follows the axis named by the N-th
-// letter of coordinates=); the kins_* components exist for other machines, wired externally
-// from the axis.L.pos-cmd pins.
+// Joints are the machine's motors: every period the sampled axis position goes through the
+// machine's kinematics (kins_link.hpp: built-in trivial, or the kins_* module named by kins=)
+// to joint.N.motor-pos-cmd, and the joint feedback back through forward() to axis.L.pos-fb.
+// Following errors, limit switches and joint velocity/acceleration are per joint; soft limits
+// are per axis (checked by the planner).
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -23,6 +25,7 @@
 #include "hal/component.hpp"
 #include "interp/canon_wire.hpp"
 #include "interp/dialect.hpp"
+#include "kins_link.hpp"
 #include "motion/kinematics.hpp"
 #include "motion/planner.hpp"
 #include "motion/sampler.hpp"
@@ -37,7 +40,7 @@ constexpr long kMaxDio = 64;  // NcStudio's M901 H0..H63
 
 // Why motion faulted, kept by the servo function for the text printed in the configuration
 // world (stop or unload). Drive faults and following errors are told by their own pins.
-enum class FaultCause : std::uint8_t { None, EStop, PosLimit, NegLimit, WaitTimeout };
+enum class FaultCause : std::uint8_t { None, EStop, PosLimit, NegLimit, WaitTimeout, KinsLost };
 struct FaultReport {
     FaultCause cause = FaultCause::None;
     int joint = 0;
@@ -53,6 +56,7 @@ enum class EStop : std::uint8_t { Ready, Tripped, Resetting };
 struct AxisPins {
     int axis;  // index into motion::AxisArray
     std::unique_ptr<hal::Out<double>> pos_cmd;
+    std::unique_ptr<hal::Out<double>> pos_fb;  // forward kinematics of the joint feedback
     std::unique_ptr<hal::Param<double>> max_velocity;
     std::unique_ptr<hal::Param<double>> max_acceleration;
     std::unique_ptr<hal::Param<double>> max_jerk;
@@ -80,9 +84,9 @@ class Motion : public hal::Instance {
     }
 
     Motion()
-        : coordinates_(read_coordinates()),
-          kins_(coordinates_),
-          joint_count_(kins_.joint_count()),
+        : kins_(link_kinematics()),
+          coordinates_(machine_coordinates()),
+          joint_count_(kins_.kins().joint_count()),
           motor_pos_cmd_(this, pin("joint.{}.motor-pos-cmd"), joint_count_),
           motor_pos_fb_(this, pin("joint.{}.motor-pos-fb"), joint_count_),
           f_error_(this, pin("joint.{}.f-error"), joint_count_),
@@ -109,6 +113,10 @@ class Motion : public hal::Instance {
         lockstep_ = arg_int("sim_lockstep", 0) != 0;
         make_axis_pins();
         joint_cmd_mm_.assign(joint_count_, 0.0);
+        joint_fb_mm_.assign(joint_count_, 0.0);
+        joint_vel_mm_s_.assign(joint_count_, 0.0);
+        joint_prev_mm_.assign(joint_count_, 0.0);
+        joint_excess_.assign(joint_count_, JointExcess{});
         pos_lim_seen_.assign(joint_count_, 0);
         neg_lim_seen_.assign(joint_count_, 0);
         shared_function<&Motion::update>("=motion-controller");
@@ -155,11 +163,13 @@ class Motion : public hal::Instance {
     void stop() override {
         if (feeder_) feeder_->stop();
         report_late_error();
+        report_joint_excess();
     }
 
     ~Motion() override {
         if (feeder_) feeder_->stop();
         report_late_error();
+        report_joint_excess();
     }
 
     void update(hal::Period p) noexcept {
@@ -173,8 +183,8 @@ class Motion : public hal::Instance {
         if (enable_rose) clear_latches();
         update_estop();
         check_limit_switches(enable);
-        const bool faulted =
-            drive_fault_ || limit_fault_ || estop_ == EStop::Tripped || program_fault_;
+        const bool faulted = drive_fault_ || limit_fault_ || estop_ == EStop::Tripped ||
+                             program_fault_ || kins_lost_;
         apply_stops(abort_, faulted);
         const bool enabled = enable && !faulted && estop_ == EStop::Ready;
 
@@ -189,11 +199,14 @@ class Motion : public hal::Instance {
         if (enabled) run_pending_action(s.line, p.s);
 
         for (const AxisPins& a : axes_) *a.pos_cmd = s.pos_mm[a.axis];
-        kins_.inverse(s.pos_mm, joint_cmd_mm_);
+        check_kinematics();  // after the actions: a tool offset set now applies now
+        kins_.kins().inverse(s.pos_mm, joint_cmd_mm_);
+        check_joint_motion(p.s, s.line);
         if (write_joints(enabled) && !drive_fault_) {
             drive_fault_ = true;  // the stop ramp starts next period; amps drop now
             for (std::size_t j = 0; j < joint_count_; ++j) amp_enable_out_[j] = false;
         }
+        write_axis_feedback(s.pos_mm);
         double v2 = 0;
         for (double v : s.vel_mm_s) v2 += v * v;
         current_vel_ = std::sqrt(v2);
@@ -206,7 +219,7 @@ class Motion : public hal::Instance {
         if (feeder_) canon_sync_ = feeder_->acknowledge(in_position);
         program_paused_ = st.block_paused || pausing_;
         fault_ = drive_fault_ || limit_fault_ || estop_ == EStop::Tripped || program_fault_ ||
-                 (feeder_ && feeder_->failed());
+                 kins_lost_ || (feeder_ && feeder_->failed());
         if (st.starved) starved_periods_ = ++starved_count_;
         ignored_commands_ = feeder_ ? feeder_->ignored_commands() : 0u;
     }
@@ -346,6 +359,9 @@ class Motion : public hal::Instance {
             case motion::ActionKind::SetToolNumber:
                 tool_number_ = a.value;
                 return true;
+            case motion::ActionKind::ToolOffset:
+                tool_offset_z_ = a.number;  // read back by the kinematics in this period
+                return true;
             case motion::ActionKind::SetOutput:
                 digital_out_[static_cast<std::size_t>(a.value)] = a.flag;
                 return true;
@@ -429,6 +445,85 @@ class Motion : public hal::Instance {
         return true;
     }
 
+    // ---- joints and kinematics ----
+
+    // The module's parameters (TRT pivots, tool offset) into this period's kinematics. An
+    // instance unloaded under a running machine leaves no geometry to trust: fault stop.
+    void check_kinematics() noexcept {
+        if (kins_.refresh() || kins_lost_) return;
+        kins_lost_ = true;
+        note_fault({FaultCause::KinsLost, 0, last_line_, {}});
+        for (std::size_t j = 0; j < joint_count_; ++j) amp_enable_out_[j] = false;
+    }
+
+    // Joint velocity and acceleration of the commands (backward differences), published on
+    // joint.N.vel-cmd / acc-cmd and checked against joint.N.max-velocity / max-acceleration.
+    // The planner limits the axes; a kinematics can still ask more of a motor (a CoreXY motor
+    // runs at X + Y, a tilted table swings the linear joints), so excesses are recorded and
+    // printed at stop, not tripped on.
+    void check_joint_motion(double dt, std::int32_t line) noexcept {
+        if (!(dt > 0)) return;
+        for (std::size_t j = 0; j < joint_count_; ++j) {
+            const double vel = joints_primed_ ? (joint_cmd_mm_[j] - joint_prev_mm_[j]) / dt : 0;
+            const double acc = joints_primed_ ? (vel - joint_vel_mm_s_[j]) / dt : 0;
+            joint_vel_mm_s_[j] = vel;
+            joint_prev_mm_[j] = joint_cmd_mm_[j];
+            joint_vel_cmd_[j] = vel;
+            joint_acc_cmd_[j] = acc;
+            note_excess(joint_excess_[j].vel, std::fabs(vel), joint_max_velocity_[j].get(), line);
+            note_excess(joint_excess_[j].acc, std::fabs(acc), joint_max_acceleration_[j].get(),
+                        line);
+        }
+        joints_primed_ = true;
+    }
+
+    // Relative slack for sampling: backward differences of an exactly limited profile can read
+    // a hair above the limit.
+    static constexpr double kJointLimitSlack = 1e-3;
+
+    struct Excess {
+        std::uint32_t periods = 0;
+        double peak = 0;
+        double limit = 0;
+        std::int32_t first_line = 0;
+    };
+    struct JointExcess {
+        Excess vel, acc;
+    };
+
+    static void note_excess(Excess& e, double value, double limit, std::int32_t line) noexcept {
+        if (!(limit > 0) || !(value > limit * (1 + kJointLimitSlack))) return;
+        if (e.periods++ == 0) e.first_line = line;
+        e.peak = std::max(e.peak, value);
+        e.limit = limit;
+    }
+
+    void write_axis_feedback(const motion::AxisArray& cmd_mm) noexcept {
+        for (std::size_t j = 0; j < joint_count_; ++j) joint_fb_mm_[j] = motor_pos_fb_[j].get();
+        motion::AxisArray fb_mm = cmd_mm;  // axes the kinematics lacks keep their command
+        kins_.kins().forward(joint_fb_mm_, fb_mm);
+        for (const AxisPins& a : axes_) *a.pos_fb = fb_mm[a.axis];
+    }
+
+    // Printed once, at the first stop or unload after the run.
+    void report_joint_excess() {
+        if (excess_reported_) return;
+        for (std::size_t j = 0; j < joint_excess_.size(); ++j) {
+            auto say = [&](const Excess& e, const char* what, const char* per, const char* param) {
+                if (e.periods == 0) return;
+                excess_reported_ = true;
+                fmt::print(stderr,
+                           "{}: joint {} was commanded a {} of {:.6g}{} in {} periods (first at "
+                           "line {}), above {} = {:.6g}: the kinematics ask more of this motor "
+                           "than the axis limits allow\n",
+                           name(), j, what, e.peak, per, e.periods, e.first_line,
+                           pin_name(fmt::format("joint.{}.{}", j, param)), e.limit);
+            };
+            say(joint_excess_[j].vel, "velocity", "/s", "max-velocity");
+            say(joint_excess_[j].acc, "acceleration", "/s^2", "max-acceleration");
+        }
+    }
+
     // Joint commands, following errors and amp enables; true if a drive reports a fault or a
     // following error exceeds its limit while enabled.
     bool write_joints(bool enabled) noexcept {
@@ -478,6 +573,11 @@ class Motion : public hal::Instance {
                                    feeder_ ? feeder_->program_file() : program_path_, r.line,
                                    pin_name(fmt::format("motion.digital-in-{:02}", r.action.value)),
                                    r.action.flag ? "TRUE" : "FALSE", r.action.number);
+            case FaultCause::KinsLost:
+                return fmt::format(
+                    "the kinematics kins={} was unloaded while motion used it; motion stopped, "
+                    "program abandoned",
+                    kins_.name());
             case FaultCause::None:
                 break;
         }
@@ -503,6 +603,45 @@ class Motion : public hal::Instance {
                 throw hal::Error(
                     fmt::format("coordinates={}: '{}' is not an axis letter (XYZABCUVW)", c, ch));
         return c;
+    }
+
+    // kins=NAME: the machine's kinematics module, loaded before motion; else the built-in
+    // trivial kinematics of coordinates= (or num_joints=).
+    motioncomp::KinsLink link_kinematics() const {
+        const auto kins = arg("kins");
+        if (!kins) return motioncomp::KinsLink::builtin(read_coordinates());
+        auto link = motioncomp::KinsLink::find(*kins);
+        if (const auto c = arg("coordinates")) {
+            const std::string want = axis_letters(link.kins());
+            std::string given = upper(*c);
+            std::sort(given.begin(), given.end(), [](char a, char b) {
+                return motion::axis_index(a) < motion::axis_index(b);
+            });
+            given.erase(std::unique(given.begin(), given.end()), given.end());
+            if (given != want)
+                throw hal::Error(fmt::format(
+                    "coordinates={} does not match kins={}, whose joints drive the axes {}", *c,
+                    *kins, want));
+        }
+        return link;
+    }
+
+    // The axes a kinematics drives, once each, in XYZABCUVW order.
+    static std::string axis_letters(const motion::Kinematics& k) {
+        std::string out;
+        for (int axis = 0; axis < motion::kAxes; ++axis)
+            for (int a : k.joint_axes())
+                if (a == axis) {
+                    out += kUpperAxes[axis];
+                    break;
+                }
+        return out;
+    }
+
+    // coordinates= as given for the built-in kinematics (a gantry's XYYZ), else the axes the
+    // module's joints drive.
+    std::string machine_coordinates() const {
+        return arg("kins") ? axis_letters(kins_.kins()) : read_coordinates();
     }
 
     std::size_t ring_capacity() const {
@@ -539,10 +678,13 @@ class Motion : public hal::Instance {
 
     void check_num_joints() const {
         const long n = arg_int("num_joints", static_cast<long>(joint_count_));
-        if (n != static_cast<long>(joint_count_))
-            throw hal::Error(fmt::format(
-                "num_joints={} does not match coordinates={} ({} joints, one per letter)", n,
-                coordinates_, joint_count_));
+        if (n == static_cast<long>(joint_count_)) return;
+        if (arg("kins"))
+            throw hal::Error(fmt::format("num_joints={} does not match kins={} ({} joints)", n,
+                                         kins_.name(), joint_count_));
+        throw hal::Error(
+            fmt::format("num_joints={} does not match coordinates={} ({} joints, one per letter)",
+                        n, coordinates_, joint_count_));
     }
 
     void make_axis_pins() {
@@ -552,6 +694,7 @@ class Motion : public hal::Instance {
             AxisPins a;
             a.axis = k;
             a.pos_cmd = std::make_unique<hal::Out<double>>(this, stem + ".pos-cmd");
+            a.pos_fb = std::make_unique<hal::Out<double>>(this, stem + ".pos-fb");
             a.max_velocity =
                 std::make_unique<hal::Param<double>>(this, stem + ".max-velocity", 100.0);
             a.max_acceleration =
@@ -600,8 +743,8 @@ class Motion : public hal::Instance {
         return plan;
     }
 
+    motioncomp::KinsLink kins_;
     std::string coordinates_;
-    motion::TrivialKinematics kins_;
     std::size_t joint_count_;
 
     hal::Array<hal::Out<double>> motor_pos_cmd_;
@@ -612,6 +755,13 @@ class Motion : public hal::Instance {
     hal::Array<hal::Out<double>> f_error_lim_{this, pin("joint.{}.f-error-lim"), joint_count_};
     hal::Array<hal::Out<bool>> f_errored_{this, pin("joint.{}.f-errored"), joint_count_};
     hal::Array<hal::Param<double>> max_ferror_{this, pin("joint.{}.max-ferror"), joint_count_};
+    hal::Array<hal::Out<double>> joint_vel_cmd_{this, pin("joint.{}.vel-cmd"), joint_count_};
+    hal::Array<hal::Out<double>> joint_acc_cmd_{this, pin("joint.{}.acc-cmd"), joint_count_};
+    // LinuxCNC's [JOINT_N]MAX_VELOCITY / MAX_ACCELERATION; 0 = not checked.
+    hal::Array<hal::Param<double>> joint_max_velocity_{this, pin("joint.{}.max-velocity"),
+                                                       joint_count_};
+    hal::Array<hal::Param<double>> joint_max_acceleration_{
+        this, pin("joint.{}.max-acceleration"), joint_count_};
     hal::Array<hal::In<bool>> pos_lim_sw_in_{this, pin("joint.{}.pos-lim-sw-in"), joint_count_};
     hal::Array<hal::In<bool>> neg_lim_sw_in_{this, pin("joint.{}.neg-lim-sw-in"), joint_count_};
     // Published for LinuxCNC HAL files; homing is not implemented yet, so nothing reads it.
@@ -641,6 +791,8 @@ class Motion : public hal::Instance {
     hal::Out<bool> tool_change_{this, pin("iocontrol.0.tool-change")};
     hal::In<bool> tool_changed_{this, pin("iocontrol.0.tool-changed")};
     hal::Out<std::int32_t> tool_number_{this, pin("iocontrol.0.tool-number")};
+    // LinuxCNC motion's tool length offset in Z; a TRT config nets it to kins.tool-offset.
+    hal::Out<double> tool_offset_z_{this, pin("motion.tooloffset.z")};
     // TRUE by default (unlike LinuxCNC's) so a config without an e-stop chain runs.
     hal::In<bool> emc_enable_in_{this, pin("iocontrol.0.emc-enable-in"), true};
     hal::Out<bool> user_enable_out_{this, pin("iocontrol.0.user-enable-out"), true};
@@ -671,6 +823,13 @@ class Motion : public hal::Instance {
     std::string dialect_;
     double servo_period_s_ = 1e-3;
     std::vector<double> joint_cmd_mm_;
+    std::vector<double> joint_fb_mm_;    // scratch for forward()
+    std::vector<double> joint_prev_mm_;  // last period's joint command
+    std::vector<double> joint_vel_mm_s_;
+    std::vector<JointExcess> joint_excess_;
+    bool joints_primed_ = false;  // joint_prev_mm_ holds a real command
+    bool excess_reported_ = false;
+    bool kins_lost_ = false;  // latched for good: the geometry is gone
     bool abort_seen_ = false;
     bool fault_seen_ = false;
     bool stop_seen_ = false;  // an abort or a fault stop was requested last period
@@ -701,5 +860,5 @@ class Motion : public hal::Instance {
 }  // namespace
 
 HAL_COMPONENT(motion, Motion, "Trajectory planner and servo-rate motion controller", "num_joints",
-              "coordinates", "program", "canon", "dialect", "servo_period_nsec", "queue", "sim_lockstep",
+              "coordinates", "kins", "program", "canon", "dialect", "servo_period_nsec", "queue", "sim_lockstep",
               "num_dio")

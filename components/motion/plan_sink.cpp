@@ -131,9 +131,13 @@ class PlanSink final : public interp::CanonSink {
         queue(loc, {s.optional ? motion::ActionKind::OptionalPause : motion::ActionKind::Pause,
                     false, 0, 0});
     }
+    // The end points include the tool length already; motion publishes it in program order
+    // on motion.tooloffset.z for a kinematics that must know it (kins_xyzac_trt's tool-offset).
+    void handle(const interp::SourceLoc& loc, const interp::canon::ToolOffset& t) {
+        queue(loc, {motion::ActionKind::ToolOffset, false, 0, t.offset_mm[2]});
+    }
     // Informational: end points already include offsets, units and plane are per move.
     void handle(const interp::SourceLoc&, const interp::canon::Offsets&) {}
-    void handle(const interp::SourceLoc&, const interp::canon::ToolOffset&) {}
     void handle(const interp::SourceLoc&, const interp::canon::Units&) {}
     void handle(const interp::SourceLoc&, const interp::canon::SelectPlane&) {}
     void handle(const interp::SourceLoc&, const interp::canon::SetFeedMode&) {}

@@ -5,6 +5,8 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <atomic>
+#include <cstdint>
 #include <memory>
 #include <span>
 #include <string>
@@ -85,6 +87,64 @@ class XyzacTrtKinematics final : public Kinematics {
   private:
     static constexpr int axes_[5] = {0, 1, 2, 3, 5};
     TrtPivots pv_;
+};
+
+// Tool length for XyzacTrtKinematics: the program's end points include the tool length offset
+// in Z (G43), i.e. they are the spindle nose, tool_length_mm above the tip along the workpiece
+// Z. With the table tilted the tool still hangs along the machine Z, so the nose must sit
+// tool_length_mm above the tip along the *machine* Z. Moving the A pivot up by the same
+// length does exactly that (LinuxCNC's xyzac-trt-kins adds its tool-offset pin to the pivot
+// Z the same way): for nose = tip + L z,  Rc(nose - c) = Rc(tip - c) + L z, so
+//     m(nose, a_pivot + L z) = m(tip, a_pivot) + L z   for every A and C.
+// The pivots given to set_pivots() already include it; see kins_xyzac_trt's tool-offset pin.
+
+// ---- Kinematics modules in HAL --------------------------------------------------------------
+//
+// A kinematics .so (components/kins/*) is a HAL component whose instances carry a machine's
+// geometry on pins. The motion component uses one with `loadrt motion kins=NAME`, the way
+// LinuxCNC's motmod calls the kins module loaded before it: it asks the module for the
+// KinematicsSource of the instance NAME, builds its own Kinematics with make() and calls
+// refresh() and inverse() every servo period.
+
+// What a kinematics module's instance offers to another component. Shared between the
+// instance and its users (shared_ptr), so it outlives an instance that is unloaded first.
+class KinematicsSource {
+  public:
+    virtual ~KinematicsSource() = default;
+    // Configuration world: a kinematics of this machine, for the caller to own.
+    virtual std::unique_ptr<Kinematics> make() const = 0;
+    // Realtime: copies the instance's current parameters (its pins) into `k`, which make()
+    // built. Returns false, touching nothing, once the instance has been unloaded; `k` then
+    // keeps the last parameters.
+    bool refresh(Kinematics& k) const noexcept {
+        if (!attached_.load(std::memory_order_acquire)) return false;
+        copy_params(k);
+        return true;
+    }
+    // Configuration world: called by the instance's destructor, before its pins go.
+    void detach() noexcept { attached_.store(false, std::memory_order_release); }
+
+  protected:
+    // Realtime: reads the pins into `k` (a kinematics from make()). Default: no parameters.
+    virtual void copy_params(Kinematics&) const noexcept {}
+
+  private:
+    std::atomic<bool> attached_{true};
+};
+
+// The C entry point every kinematics .so exports beside cnc_hal_component:
+//     extern "C" const motion::KinematicsModule* cnc_kinematics_module();
+inline constexpr char kKinematicsEntryPoint[] = "cnc_kinematics_module";
+inline constexpr std::uint32_t kKinematicsAbiVersion = 1;
+
+struct KinematicsModule {
+    std::uint32_t abi_version;  // first, and kept first by every future version
+    const char* name;           // the module: "kins_corexy"
+    // The source of this module's instance named `name`, or of its only instance when `name`
+    // is the module's name; null when there is none. Configuration world.
+    std::shared_ptr<KinematicsSource> (*find)(std::string_view name);
+    // The names of the module's live instances, for error messages.
+    std::vector<std::string> (*instances)();
 };
 
 // Builds a kinematics by name: "trivial" (with coordinates), "corexy", "xyzac-trt".

@@ -26,6 +26,7 @@ enum class ActionKind : std::uint8_t {
     WaitInput,      // value = digital input index, flag = level, number = timeout in s
     Pause,          // M00
     OptionalPause,  // M01: pauses only while the optional-stop switch is on
+    ToolOffset,     // number = tool length offset in Z, mm (G43/G49): motion.tooloffset.z
 };
 
 struct Action {

@@ -1,0 +1,124 @@
+// The sim machines whose motion component runs a kins_* module (kins=kins), end to end with
+// `cnc run --sim-clock`: joints are motors, so a lagging drive shows its following error on
+// its own joint, and a gantry's two Y motors are two joints.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cnc_run_harness.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using cnc_test::run_cnc;
+using cnc_test::RunResult;
+using cnc_test::ScratchDir;
+using cnc_test::slurp;
+
+struct Edit {
+    std::string section;  // "JOINT_1"; "JOINT_" for every joint
+    std::string key, value;
+};
+
+// configs/sim/NAME.ini with the HAL files and HALLIB by absolute path and the edits applied.
+std::string ini_with(const std::string& name, const std::vector<Edit>& edits) {
+    const fs::path dir = fs::path(CNC_SOURCE_DIR) / "configs/sim";
+    std::istringstream in(slurp(dir / (name + ".ini")));
+    std::string text, line, section;
+    while (std::getline(in, line)) {
+        if (line.rfind('[', 0) == 0) section = line.substr(1, line.find(']') - 1);
+        if (line.rfind("HALFILE = ", 0) == 0 || line.rfind("HALLIB = ", 0) == 0 ||
+            line.rfind("TOOL_TABLE = ", 0) == 0 || line.rfind("PARAMETER_FILE = ", 0) == 0) {
+            const auto eq = line.find(" = ");
+            line = fmt::format("{} = {}/{}", line.substr(0, eq), dir.string(), line.substr(eq + 3));
+        }
+        for (const Edit& e : edits) {
+            const bool here =
+                e.section.back() == '_' ? section.rfind(e.section, 0) == 0 : section == e.section;
+            if (here && line.rfind(e.key + " = ", 0) == 0) line = e.key + " = " + e.value;
+        }
+        text += line + "\n";
+    }
+    return text;
+}
+
+// "j0 0.0000  j1 2.4000 ..." of the summary -> {0.0, 2.4, ...}
+std::vector<double> max_ferrors(const std::string& out) {
+    const std::string key = "max following error (mm): ";
+    const auto at = out.find(key);
+    std::vector<double> v;
+    if (at == std::string::npos) return v;
+    std::istringstream in(out.substr(at + key.size(), out.find('\n', at) - at - key.size()));
+    std::string name;
+    double x;
+    while (in >> name >> x) v.push_back(x);
+    return v;
+}
+
+struct MachineRun {
+    ScratchDir scratch;
+    RunResult result;
+    MachineRun(const std::string& ini_text, const std::string& program) {
+        const fs::path ini = scratch.path() / "m.ini", ngc = scratch.path() / "p.ngc";
+        std::ofstream(ini) << ini_text;
+        std::ofstream(ngc) << program;
+        result = run_cnc(fmt::format("'{}' '{}' --sim-clock", ini.string(), ngc.string()),
+                         scratch.path());
+    }
+};
+
+// A pure Y move on a CoreXY turns both motors, A = X + Y forward and B = X - Y backward, at
+// the Y speed (50 mm/s here). motion is first in the servo thread, so its f-error compares this
+// period's command with last period's feedback: a motor that follows exactly shows one period
+// of travel, 50 mm/s x 1 ms = 0.05 mm (plus half an encoder count, 0.0005). Motor B's drive
+// lags (first-order, 50 ms): it trails by up to speed x lag = 2.5 mm more, reached to within
+// e^-18 during the 1 s cruise. Per-axis errors would have shown half of it on X and half on Y.
+const char* kYMove = "G90 G21\nG01 Y50 F3000\nM30\n";
+constexpr double kFollows = 0.05 + 0.0005 + 1e-6;
+constexpr double kLagsMin = 2.4, kLagsMax = 2.5 + kFollows;
+
+TEST(CoreXY, LaggingMotorShowsItsFollowingErrorOnItsOwnJoint) {
+    MachineRun run(ini_with("corexy", {{"JOINT_1", "SIM_LAG", "0.05"}, {"JOINT_", "FERROR", "10"}}),
+                   kYMove);
+    ASSERT_EQ(run.result.exit_code, 0) << run.result.err << run.result.out;
+    const std::vector<double> fe = max_ferrors(run.result.out);
+    ASSERT_EQ(fe.size(), 3u) << run.result.out;
+    EXPECT_LE(fe[0], kFollows);
+    EXPECT_GT(fe[1], kLagsMin);
+    EXPECT_LE(fe[1], kLagsMax);
+    EXPECT_EQ(fe[2], 0.0);  // Z does not move
+    EXPECT_NE(run.result.out.find("final position (mm): x 0.0000  y 50.0000  z 0.0000"),
+              std::string::npos)
+        << run.result.out;
+}
+
+TEST(CoreXY, LaggingMotorTripsItsOwnJoint) {
+    // corexy.ini's FERROR of 1 mm on every joint: motor B passes it, motor A never comes near.
+    MachineRun run(ini_with("corexy", {{"JOINT_1", "SIM_LAG", "0.05"}}), kYMove);
+    EXPECT_EQ(run.result.exit_code, 1);
+    EXPECT_NE(run.result.err.find(":2: following error on joint 1: "), std::string::npos)
+        << run.result.err;
+    EXPECT_EQ(run.result.err.find("on joint 0"), std::string::npos) << run.result.err;
+}
+
+// Gantry XYYZ: joints 1 and 2 are the two Y motors. One lags: its own joint shows it, the
+// other Y motor follows exactly; both end at Y.
+TEST(Gantry, TwoYMotorsAreTwoJoints) {
+    MachineRun run(ini_with("gantry", {{"JOINT_2", "SIM_LAG", "0.05"}, {"JOINT_", "FERROR", "10"}}),
+                   kYMove);
+    ASSERT_EQ(run.result.exit_code, 0) << run.result.err << run.result.out;
+    const std::vector<double> fe = max_ferrors(run.result.out);
+    ASSERT_EQ(fe.size(), 4u) << run.result.out;
+    EXPECT_EQ(fe[0], 0.0);  // X does not move
+    EXPECT_LE(fe[1], kFollows);
+    EXPECT_GT(fe[2], kLagsMin);
+    EXPECT_LE(fe[2], kLagsMax);
+    EXPECT_EQ(fe[3], 0.0);
+}
+
+}  // namespace
