@@ -536,7 +536,7 @@ class Motion : public hal::Instance {
             f_error_[j] = ferror;
             f_error_lim_[j] = limit;
             f_errored_[j] = errored;
-            amp_enable_out_[j] = enabled;
+            amp_enable_out_[j] = enabled && !kins_lost_;
             // A disabled machine may sit anywhere: only an enabled one trips.
             fault = fault || (enabled && (errored || amp_fault_in_[j].get()));
         }
