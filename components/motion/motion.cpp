@@ -40,12 +40,21 @@ constexpr long kMaxDio = 64;  // NcStudio's M901 H0..H63
 
 // Why motion faulted, kept by the servo function for the text printed in the configuration
 // world (stop or unload). Drive faults and following errors are told by their own pins.
-enum class FaultCause : std::uint8_t { None, EStop, PosLimit, NegLimit, WaitTimeout, KinsLost };
+enum class FaultCause : std::uint8_t {
+    None,
+    EStop,
+    PosLimit,
+    NegLimit,
+    WaitTimeout,
+    KinsLost,
+    ToolOffsetJump
+};
 struct FaultReport {
     FaultCause cause = FaultCause::None;
     int joint = 0;
     std::int32_t line = 0;
     motion::Action action;
+    double amount = 0;  // ToolOffsetJump: how far the joint would have jumped
 };
 
 // The e-stop handshake of LinuxCNC's iocontrol: iocontrol.0.emc-enable-in FALSE trips it
@@ -117,6 +126,8 @@ class Motion : public hal::Instance {
         joint_vel_mm_s_.assign(joint_count_, 0.0);
         joint_prev_mm_.assign(joint_count_, 0.0);
         joint_excess_.assign(joint_count_, JointExcess{});
+        offset_before_mm_.assign(joint_count_, 0.0);
+        offset_after_mm_.assign(joint_count_, 0.0);
         pos_lim_seen_.assign(joint_count_, 0);
         neg_lim_seen_.assign(joint_count_, 0);
         shared_function<&Motion::update>("=motion-controller");
@@ -196,6 +207,7 @@ class Motion : public hal::Instance {
         if (resume_rose_ && sampler_->status().block_paused) sampler_->resume_block();
         const motion::MotionSample s = sampler_->advance(p.s);
         const motion::SamplerStatus& st = sampler_->status();
+        action_pos_mm_ = s.pos_mm;  // standing on an action: where the machine stands
         if (enabled) run_pending_action(s.line, p.s);
 
         for (const AxisPins& a : axes_) *a.pos_cmd = s.pos_mm[a.axis];
@@ -360,8 +372,7 @@ class Motion : public hal::Instance {
                 tool_number_ = a.value;
                 return true;
             case motion::ActionKind::ToolOffset:
-                tool_offset_z_ = a.number;  // read back by the kinematics in this period
-                return true;
+                return set_tool_offset(a, line);
             case motion::ActionKind::SetOutput:
                 digital_out_[static_cast<std::size_t>(a.value)] = a.flag;
                 return true;
@@ -446,6 +457,41 @@ class Motion : public hal::Instance {
     }
 
     // ---- joints and kinematics ----
+
+    // G43/G49 (or M30's reset) while the machine stands on the action. A kinematics that uses
+    // the tool length (TRT: motion.tooloffset.z => tool-offset) maps the same axis position
+    // to other joints when it changes; with the table tilted they would jump by
+    // (I - Ra) L z. That is refused as a program error before anything moves (LinuxCNC just
+    // jumps); with the rotary axes at 0, or a kinematics that ignores the tool, nothing moves
+    // and the offset is taken.
+    bool set_tool_offset(const motion::Action& a, std::int32_t line) noexcept {
+        const double before_mm = tool_offset_z_mm_;
+        kins_.refresh();
+        kins_.kins().inverse(action_pos_mm_, offset_before_mm_);
+        tool_offset_z_ = a.number;  // the kinematics reads it through its tool-offset pin
+        kins_.refresh();
+        kins_.kins().inverse(action_pos_mm_, offset_after_mm_);
+        double jump_mm = 0;
+        int joint = 0;
+        for (std::size_t j = 0; j < joint_count_; ++j) {
+            const double d = std::fabs(offset_after_mm_[j] - offset_before_mm_[j]);
+            if (d > jump_mm) {
+                jump_mm = d;
+                joint = static_cast<int>(j);
+            }
+        }
+        if (jump_mm <= kToolOffsetJumpMm) {
+            tool_offset_z_mm_ = a.number;
+            return true;
+        }
+        tool_offset_z_ = before_mm;
+        kins_.refresh();
+        program_fault_ = true;
+        note_fault({FaultCause::ToolOffsetJump, joint, line, a, jump_mm});
+        return false;  // the fault stop discards the queue, this action with it
+    }
+
+    static constexpr double kToolOffsetJumpMm = 1e-6;
 
     // The module's parameters (TRT pivots, tool offset) into this period's kinematics. An
     // instance unloaded under a running machine leaves no geometry to trust: fault stop.
@@ -573,6 +619,14 @@ class Motion : public hal::Instance {
                                    feeder_ ? feeder_->program_file() : program_path_, r.line,
                                    pin_name(fmt::format("motion.digital-in-{:02}", r.action.value)),
                                    r.action.flag ? "TRUE" : "FALSE", r.action.number);
+            case FaultCause::ToolOffsetJump:
+                return fmt::format(
+                    "{}:{}: the tool length offset changes to {} mm while the kinematics use it: "
+                    "joint {} would jump {:.4f} mm (the table is tilted); change the tool offset "
+                    "(G43/G49, and M30's reset) with the rotary axes at 0; motion stopped, "
+                    "program abandoned",
+                    feeder_ ? feeder_->program_file() : program_path_, r.line, r.action.number,
+                    r.joint, r.amount);
             case FaultCause::KinsLost:
                 return fmt::format(
                     "the kinematics kins={} was unloaded while motion used it; motion stopped, "
@@ -830,6 +884,9 @@ class Motion : public hal::Instance {
     bool joints_primed_ = false;  // joint_prev_mm_ holds a real command
     bool excess_reported_ = false;
     bool kins_lost_ = false;  // latched for good: the geometry is gone
+    motion::AxisArray action_pos_mm_{};  // this period's sampled position
+    double tool_offset_z_mm_ = 0;        // motion.tooloffset.z as last written
+    std::vector<double> offset_before_mm_, offset_after_mm_;  // scratch for set_tool_offset
     bool abort_seen_ = false;
     bool fault_seen_ = false;
     bool stop_seen_ = false;  // an abort or a fault stop was requested last period
