@@ -1,6 +1,7 @@
 #include "interp/lexer.hpp"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -65,31 +66,56 @@ namespace {
 constexpr double kPow10[] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,  1e8,  1e9,  1e10, 1e11,
                              1e12, 1e13, 1e14, 1e15, 1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
 
+// What a byte can start. Letters, digits and spaces make up nearly all of a G-code line, so one
+// table lookup sends them to their own branch before any of the rarer cases is considered.
+enum class CharClass : std::uint8_t { Other, Space, Letter, Digit };
+
+constexpr std::array<CharClass, 256> make_char_classes() {
+    std::array<CharClass, 256> t{};
+    for (int c = 0; c < 256; ++c) {
+        const char ch = static_cast<char>(c);
+        if (is_space(ch)) t[c] = CharClass::Space;
+        if (is_alpha(ch)) t[c] = CharClass::Letter;
+        if (is_digit(ch)) t[c] = CharClass::Digit;
+    }
+    return t;
+}
+
+constexpr std::array<CharClass, 256> kCharClass = make_char_classes();
+
+CharClass char_class(char c) {
+    return kCharClass[static_cast<unsigned char>(c)];
+}
+
+// Accumulates the decimal digits from p on into `mantissa`; returns the first non-digit.
+const char* scan_digits(const char* p, const char* end, std::uint64_t& mantissa) {
+    for (; p != end; ++p) {
+        const unsigned d = static_cast<unsigned char>(*p) - unsigned{'0'};
+        if (d > 9) break;
+        mantissa = mantissa * 10 + d;
+    }
+    return p;
+}
+
 // Parses [digits][.digits] starting at s[i]; the caller guarantees a digit or '.' there.
 // Integer mantissas below 2^53 divided by an exact power of ten round once, so the fast path is
 // correctly rounded; longer literals go through from_chars.
 std::size_t scan_number(std::string_view s, std::size_t i, Token& tok) {
-    const std::size_t start = i;
+    const char* const start = s.data() + i;
+    const char* const end = s.data() + s.size();
     std::uint64_t mantissa = 0;
-    int digits = 0;
+    const char* p = scan_digits(start, end, mantissa);
+    std::ptrdiff_t digits = p - start;
     int frac_digits = 0;
-    while (i < s.size() && is_digit(s[i])) {
-        mantissa = mantissa * 10 + static_cast<unsigned>(s[i] - '0');
-        ++digits;
-        ++i;
-    }
-    if (i < s.size() && s[i] == '.') {
+    if (p != end && *p == '.') {
         tok.has_point = true;
-        ++i;
-        while (i < s.size() && is_digit(s[i])) {
-            mantissa = mantissa * 10 + static_cast<unsigned>(s[i] - '0');
-            ++digits;
-            ++frac_digits;
-            ++i;
-        }
+        const char* const frac = p + 1;
+        p = scan_digits(frac, end, mantissa);
+        frac_digits = static_cast<int>(p - frac);
+        digits += frac_digits;
     }
     tok.kind = Tok::Number;
-    tok.text = s.substr(start, i - start);
+    tok.text = std::string_view(start, static_cast<std::size_t>(p - start));
     if (digits <= 15) {
         // No division for integers: its latency is a large share of lexing a G1 line.
         tok.number = frac_digits == 0 ? static_cast<double>(mantissa)
@@ -103,11 +129,11 @@ std::size_t scan_number(std::string_view s, std::size_t i, Token& tok) {
         }
         if (t.back() == '.') t.remove_suffix(1);
         double v = 0.0;
-        const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+        const auto [last, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
         // Out of double range: the caller reports it with the token's column.
         tok.number = ec == std::errc{} ? v : HUGE_VAL;
     }
-    return i;
+    return i + tok.text.size();
 }
 
 // Two-character operators first, then single characters.
@@ -170,6 +196,18 @@ bool paren_is_expression(const Token* previous, int depth, bool expression_start
     return false;
 }
 
+// Whether the executable text of the line ends at s[i], a byte that is neither a space, a letter
+// nor a digit: at ';', at a ' comment, or on a '%' tape-marker line.
+bool ends_executable_text(std::string_view s, std::size_t i, bool line_start, const Dialect& d) {
+    const char c = s[i];
+    if (c == ';') return true;
+    // EXT: a '%' line (tape start/end marker in CAM output) carries nothing.
+    if (c == '%' && line_start && s.find_first_not_of(" \t%", i) == std::string_view::npos)
+        return true;
+    // Comment quotes are ' and a UTF-8 sequence starting 0xE2: test the byte first.
+    return d.quote_comments && (c == '\'' || c == '\xE2') && comment_quote_length(s.substr(i)) != 0;
+}
+
 std::string describe_byte(char c) {
     const auto u = static_cast<unsigned char>(c);
     if (u >= 0x20 && u < 0x7F) return std::string("unexpected character '") + c + "'";
@@ -204,31 +242,26 @@ void Lexer::lex(std::string_view s, const SourceLoc& loc, std::vector<Token>& ou
     };
     while (i < s.size()) {
         const char c = s[i];
-        if (is_space(c)) {
+        const CharClass cls = char_class(c);
+        if (cls == CharClass::Space) {
             space = true;
             ++i;
             continue;
         }
-        if (c == ';') break;
-        // EXT: a '%' line (tape start/end marker in CAM output) carries nothing.
-        if (c == '%' && out.empty() && s.find_first_not_of(" \t%", i) == std::string_view::npos)
-            break;
-        // Comment quotes are ' and a UTF-8 sequence starting 0xE2: test the byte first.
-        if (d.quote_comments && (c == '\'' || c == '\xE2') &&
-            comment_quote_length(s.substr(i)) != 0)
-            break;
+        if (cls == CharClass::Other && ends_executable_text(s, i, out.empty(), d)) break;
         // Built in place: copying a finished Token into the vector stalls on store forwarding.
         Token& tok = out.emplace_back();
         tok.col = static_cast<int>(i) + 1 - cont;
         tok.space_before = space;
         space = false;
-        if (is_alpha(c)) {
-            std::size_t j = i;
-            while (j < s.size() && is_alpha(s[j])) ++j;
+        if (cls == CharClass::Letter) {
+            std::size_t j = i + 1;
+            while (j < s.size() && char_class(s[j]) == CharClass::Letter) ++j;
             tok.kind = Tok::Word;
-            tok.text = s.substr(i, j - i);
+            tok.text = std::string_view(s.data() + i, j - i);
             i = j;
-        } else if (is_digit(c) || (c == '.' && i + 1 < s.size() && is_digit(s[i + 1]))) {
+        } else if (cls == CharClass::Digit ||
+                   (c == '.' && i + 1 < s.size() && is_digit(s[i + 1]))) {
             i = scan_number(s, i, tok);
             if (!std::isfinite(tok.number)) error(i - tok.text.size(), "number out of range");
         } else if (c == '#') {
