@@ -79,6 +79,12 @@ class Interpreter {
     bool custom_code_active(int code) const;
     void collect_custom_codes(Block& b, bool has_call);
     void queue_s_hook(const Block& b);
+    // What a block does to the custom cycles, committed only once the block has run.
+    struct CustomCyclePlan {
+        cycles::CustomCycles next;                     // their modal data after the block
+        std::optional<cycles::CustomCycles::Run> run;  // the O(600+n) run the block asks for
+    };
+    bool custom_cycle_involved() const;
     std::optional<cycles::CustomCycles::Run> plan_custom_cycle(Block& b,
                                                                cycles::CustomCycles& next);
     void set_fixed_cycle_vars(const cycles::CustomCycles::Run& run, const SourceLoc& loc);
@@ -104,6 +110,7 @@ class Interpreter {
     std::vector<CallFrame> stack_;
     std::vector<CustomCall> customs_;                  // custom codes of the current block
     cycles::CustomCycles custom_cycles_;  // public.dat canned cycles and their modal data
+    CustomCyclePlan cycle_plan_;          // the current block's, when it involves one
     Source* current_ = nullptr;
     bool finished_ = true;
     bool main_started_ =

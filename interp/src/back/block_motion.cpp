@@ -49,13 +49,15 @@ void BlockRun::require_feed(const char* what) {
 
 void BlockRun::move_line(bool rapid, bool machine_coords) {
     AxisVec end;
+    AxisVec prog_end{};  // the programmed end point (not under G53)
     if (machine_coords) {
         end = st.pos.machine_mm;
         for (int a = 0; a < kMachineAxes; ++a)
             if (has_axis(a))  // MCS-3 REC: tool length compensation stays active under G53
                 end[a] = axis_value(a) + (a < 3 ? st.tool.offset_mm[a] : 0.0);
     } else {
-        end = to_machine(programmed_target());
+        prog_end = programmed_target();
+        end = to_machine(prog_end);
     }
     if (rapid) {
         emit_rapid(end);
@@ -67,7 +69,7 @@ void BlockRun::move_line(bool rapid, bool machine_coords) {
     if (machine_coords)
         resync_prog();
     else
-        st.pos.prog_mm = programmed_target();
+        st.pos.prog_mm = prog_end;
 }
 
 void BlockRun::move_arc(bool ccw) {

@@ -171,9 +171,13 @@ void Interpreter::execute_line(const SourceLoc& loc) {
     customs_.clear();
     if (options_.s_hook_program && b.has('S') && !custom_code_active(kSHookCode)) queue_s_hook(b);
     if (library_) collect_custom_codes(b, flow.call.has_value());
-    cycles::CustomCycles cycles_next = custom_cycles_;
-    const std::optional<cycles::CustomCycles::Run> custom_run =
-        plan_custom_cycle(b, cycles_next);
+    // Most blocks neither call nor continue a public.dat cycle: they skip its planning and the
+    // copy of its modal data.
+    const bool cycle_planned = custom_cycle_involved();
+    if (cycle_planned) {
+        cycle_plan_.next = custom_cycles_;
+        cycle_plan_.run = plan_custom_cycle(b, cycle_plan_.next);
+    }
     const Dialect& d = *options_.dialect;
     const std::size_t new_frames = (call_frame ? 1 : 0) + customs_.size();
     if (stack_.size() + new_frames > static_cast<std::size_t>(d.max_call_depth)) {
@@ -188,8 +192,10 @@ void Interpreter::execute_line(const SourceLoc& loc) {
         stack_.clear();
         return;
     }
-    custom_cycles_ = cycles_next;
-    if (custom_run) set_fixed_cycle_vars(*custom_run, loc);
+    if (cycle_planned) {
+        custom_cycles_ = cycle_plan_.next;
+        if (cycle_plan_.run) set_fixed_cycle_vars(*cycle_plan_.run, loc);
+    }
 
     const SourcePos after_call = current_->tell();
     if (flow.ret) {
@@ -285,6 +291,14 @@ void Interpreter::queue_s_hook(const Block& b) {
         }
     }
     throw Error(b.loc_of('S'), "S hook subprogram O" + std::to_string(program) + " not found");
+}
+
+// A custom cycle is active, or the block calls a custom G code (which may start one).
+bool Interpreter::custom_cycle_involved() const {
+    if (custom_cycles_.active()) return true;
+    for (const CustomCall& c : customs_)
+        if (c.code >= kCustomGFlag && c.code < kSHookCode) return true;
+    return false;
 }
 
 // Custom canned cycles (CC-19, FC-1/FC-2): the cycles core keeps their modal data; here the
