@@ -104,6 +104,11 @@ void BlockParser::parse_word(Ctx& c) {
 
 double BlockParser::parse_value(Ctx& c, const Token& address, bool* integer_literal) {
     const Token& t = c.cur.peek();
+    if (t.kind == Tok::Number) {  // most words: a plain literal right after the letter
+        c.cur.next();
+        if (integer_literal != nullptr) *integer_literal = !t.has_point;
+        return t.number;
+    }
     if (t.kind == Tok::Op && t.op == Op::Assign) {
         c.cur.next();
         const Token& e = c.cur.peek();
