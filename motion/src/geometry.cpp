@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <string>
 
 namespace motion {
@@ -289,6 +290,165 @@ Element trim_line(const Element& line, double from, double to) noexcept {
     }
     e.length_mm = std::max(0.0, len - from - to);
     return e;
+}
+
+
+std::optional<Element> make_corner_bezier(const AxisArray& p0, const AxisArray& t1,
+                                          const AxisArray& p3, const AxisArray& t2,
+                                          double l) noexcept {
+    const double h0 = 2.0 / 3 * l;
+    double dd = 0, ds = 0, ss = 0;
+    for (int k = 0; k < kAxes; ++k) {
+        double d = p3[k] - p0[k], sk = t1[k] + t2[k];
+        dd += d * d, ds += d * sk, ss += sk * sk;
+    }
+    // The hodograph's middle control point is p3 - p0 - h (t1 + t2); its length may not
+    // exceed h: f(h) = (ss - 1) h^2 - 2 ds h + dd <= 0.
+    auto f = [&](double h) { return (ss - 1) * h * h - 2 * ds * h + dd; };
+    double h = 0;
+    const double qa = ss - 1, disc = ds * ds - qa * dd;
+    if (f(h0) <= 0) {
+        h = h0;
+    } else if (std::fabs(qa) < 1e-12) {
+        h = ds > 0 ? std::max(h0, dd / (2 * ds)) : 0.0;
+    } else if (disc >= 0) {
+        double r1 = (ds - std::sqrt(disc)) / qa, r2 = (ds + std::sqrt(disc)) / qa;
+        for (double r : {std::min(r1, r2), std::max(r1, r2)}) {
+            if (r > h0 && f(r * (1 + 1e-12)) <= 1e-12 * dd) {
+                h = r * (1 + 1e-12);
+                break;
+            }
+        }
+    }
+    if (!(h > 0)) return std::nullopt;
+    AxisArray p1, p2;
+    for (int k = 0; k < kAxes; ++k) {
+        p1[k] = p0[k] + h * t1[k];
+        p2[k] = p3[k] - h * t2[k];
+    }
+    return make_bezier(p0, p1, p2, p3);
+}
+
+namespace {
+
+// Share of the distance to be proved that an arc's chords may give away as slack.
+constexpr double kChordSlackShare = 0.02;
+// Halvings of a blend before bezier_within gives up (2^6 pieces).
+constexpr int kMaxSplitDepth = 6;
+
+void add_chords(CornerPath& path, const Element& e, double s0, double s1, double limit_mm) {
+    int n = 1;
+    double slack = 0;
+    if (e.kind == ElementKind::Arc) {
+        double dphi = std::fabs(e.sweep_rad) * (s1 - s0) / e.length_mm;
+        double want = dphi * std::sqrt(e.radius_mm / (8 * kChordSlackShare * limit_mm));
+        n = std::clamp(int(std::ceil(want)), 1, CornerPath::kMaxChordsPerMove);
+        slack = e.radius_mm * (dphi / n) * (dphi / n) / 8;
+    }
+    CurvePoint a, b;
+    evaluate(e, s0, a);
+    for (int i = 1; i <= n; ++i, a = b) {
+        evaluate(e, i == n ? s1 : s0 + (s1 - s0) * i / n, b);
+        const int c = path.count++;
+        double len2 = 0;
+        for (int k = 0; k < kAxes; ++k) {
+            path.from[c][k] = a.p[k];
+            path.dir[c][k] = b.p[k] - a.p[k];
+            len2 += path.dir[c][k] * path.dir[c][k];
+        }
+        path.inv_len2[c] = len2 > 0 ? 1 / len2 : 0;
+        path.slack_mm[c] = slack;
+    }
+}
+
+// Squared distance from q to chord c.
+double chord_dist2(const CornerPath& path, int c, const AxisArray& q) {
+    const AxisArray &a = path.from[c], &d = path.dir[c];
+    double t = 0;
+    for (int k = 0; k < kAxes; ++k) t += (q[k] - a[k]) * d[k];
+    t = std::clamp(t * path.inv_len2[c], 0.0, 1.0);
+    double r = 0;
+    for (int k = 0; k < kAxes; ++k) {
+        double x = q[k] - a[k] - t * d[k];
+        r += x * x;
+    }
+    return r;
+}
+
+using Hull = std::array<AxisArray, 4>;  // a Bezier piece's control points
+
+// Whether all of the piece's control points lie within limit - slack of chord c.
+bool hull_near_chord(const CornerPath& path, int c, const Hull& q, double limit_mm) {
+    double room = limit_mm - path.slack_mm[c];
+    if (room <= 0) return false;
+    for (const AxisArray& p : q)
+        if (chord_dist2(path, c, p) > room * room) return false;
+    return true;
+}
+
+// Tries the chord that held the previous piece first: the pieces follow the path in order.
+bool hull_near_path(const CornerPath& path, const Hull& q, double limit_mm, int& hint) {
+    for (int c = hint; c < path.count; ++c)
+        if (hull_near_chord(path, c, q, limit_mm)) return hint = c, true;
+    for (int c = hint - 1; c >= 0; --c)
+        if (hull_near_chord(path, c, q, limit_mm)) return hint = c, true;
+    return false;
+}
+
+// A curve point that no chord holds within limit - slack: no piece through it can be proved.
+bool beyond_reach(const CornerPath& path, const AxisArray& p, double limit_mm) {
+    for (int c = 0; c < path.count; ++c) {
+        double room = limit_mm - path.slack_mm[c];
+        if (room > 0 && chord_dist2(path, c, p) <= room * room) return false;
+    }
+    return true;
+}
+
+// de Casteljau at u = 1/2.
+void split_half(const Hull& q, Hull& left, Hull& right) {
+    for (int k = 0; k < kAxes; ++k) {
+        double p01 = (q[0][k] + q[1][k]) / 2, p12 = (q[1][k] + q[2][k]) / 2,
+               p23 = (q[2][k] + q[3][k]) / 2;
+        double p012 = (p01 + p12) / 2, p123 = (p12 + p23) / 2;
+        double mid = (p012 + p123) / 2;
+        left[0][k] = q[0][k], left[1][k] = p01, left[2][k] = p012, left[3][k] = mid;
+        right[0][k] = mid, right[1][k] = p123, right[2][k] = p23, right[3][k] = q[3][k];
+    }
+}
+
+}  // namespace
+
+CornerPath corner_path(const Element& before, double before_mm, const Element& after,
+                       double after_mm, double limit_mm) noexcept {
+    CornerPath path;
+    const double len = before.length_mm;
+    add_chords(path, before, std::max(0.0, len - before_mm), len, limit_mm);
+    add_chords(path, after, 0, std::min(after_mm, after.length_mm), limit_mm);
+    return path;
+}
+
+bool bezier_within(const Element& bezier, const CornerPath& path, double limit_mm) noexcept {
+    // Depth-first over the halvings: `pending` holds the right halves still to be proved.
+    std::array<Hull, kMaxSplitDepth + 1> pending;
+    std::array<int, kMaxSplitDepth + 1> pending_depth{};
+    int top = 0, depth = 0, hint = 0;
+    Hull piece{bezier.origin, bezier.a, bezier.b, bezier.end};
+    for (;;) {
+        // The whole blend spans both moves: start with its halves.
+        if (depth > 0 && hull_near_path(path, piece, limit_mm, hint)) {
+            if (top == 0) return true;
+            --top;
+            piece = pending[top];
+            depth = pending_depth[top];
+            continue;
+        }
+        if (depth == kMaxSplitDepth) return false;
+        Hull left;
+        split_half(piece, left, pending[top]);
+        if (beyond_reach(path, left[3], limit_mm)) return false;
+        pending_depth[top++] = ++depth;
+        piece = left;
+    }
 }
 
 }  // namespace motion

@@ -51,15 +51,14 @@ double speed_cap(const Element& e, const ElementBounds& b, const AxisLimits& lim
 }
 
 // Largest a with sqrt((a t)^2 + n^2) + a l <= m: the in-plane part of an arc's acceleration is
-// a rotating vector, so tangential and centripetal parts add in quadrature, not linearly.
+// a rotating vector, so tangential and centripetal parts add in quadrature, not linearly. The
+// left side grows with a, so this is the root of (t^2 - l^2) a^2 + 2 m l a + n^2 - m^2 = 0 with
+// m - a l >= 0, written in the form that stays exact for t = l and for l = 0; 0 when the
+// centripetal part n alone uses up m.
 double arc_axis_acc(double t, double l, double n, double m) {
     if (t == 0 && l == 0) return kInf;
-    double lo = 0, hi = m / std::max(t, l);  // sqrt(.) >= a t and >= 0, so a <= m / max(t, l)
-    for (int i = 0; i < 50; ++i) {
-        double mid = (lo + hi) / 2;
-        (std::sqrt(mid * t * mid * t + n * n) + mid * l <= m ? lo : hi) = mid;
-    }
-    return lo;
+    if (n >= m) return 0;
+    return (m - n) * (m + n) / (m * l + std::sqrt(m * m * t * t - n * n * (t * t - l * l)));
 }
 
 double tangential_acc(const Element& e, const ElementBounds& b, const AxisLimits& lim, double v,

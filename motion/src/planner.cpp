@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -29,13 +30,9 @@ constexpr std::size_t kMaxGroupItems = 256;
 constexpr double kMaxArcBlendSin = 1.35;
 // Share of an arc a corner blend may take (less than half: an arc never vanishes).
 constexpr double kMaxArcTrimShare = 0.45;
-// Checking a blend with an arc: the blend is sampled at kDeviationSamples points (the largest
-// refined in kDeviationRefine golden-section steps) against the programmed moves' last and first
-// kDeviationReach * l as kDeviationChords chords each; the result must be within
-// kDeviationMargin of the tolerance, else l shrinks by 0.7, at most kBlendAttempts times.
-constexpr int kDeviationSamples = 48;
-constexpr int kDeviationChords = 32;
-constexpr int kDeviationRefine = 16;
+// Checking a blend with an arc: it must provably stay within kDeviationMargin of the tolerance
+// from the programmed moves' last and first kDeviationReach * l (bezier_within, geometry.hpp),
+// else l shrinks by 0.7, at most kBlendAttempts times.
 constexpr double kDeviationReach = 2;
 constexpr double kDeviationMargin = 0.95;
 constexpr int kBlendAttempts = 12;
@@ -216,120 +213,6 @@ Element trimmed(const Element& e, double from_mm, double to_mm) {
     return e.kind == ElementKind::Line ? trim_line(e, from_mm, to_mm) : trim_arc(e, from_mm, to_mm);
 }
 
-double dist2(const AxisArray& a, const AxisArray& b) {
-    double d = 0;
-    for (int k = 0; k < kAxes; ++k) d += (a[k] - b[k]) * (a[k] - b[k]);
-    return d;
-}
-
-// Squared distance from q to the segment [a, b].
-double segment_dist2(const AxisArray& q, const AxisArray& a, const AxisArray& b) {
-    double ab2 = dist2(a, b), t = 0;
-    if (ab2 > 0) {
-        for (int k = 0; k < kAxes; ++k) t += (q[k] - a[k]) * (b[k] - a[k]);
-        t = std::clamp(t / ab2, 0.0, 1.0);
-    }
-    double d = 0;
-    for (int k = 0; k < kAxes; ++k) {
-        double x = a[k] + t * (b[k] - a[k]) - q[k];
-        d += x * x;
-    }
-    return d;
-}
-
-// The piece [s0, s1] of e as a chain of chords (one for a line), and how far the curve may
-// bulge beyond them.
-struct Chords {
-    std::array<AxisArray, kDeviationChords + 1> pts;
-    int count = 0;  // chords
-    double sagitta_mm = 0;
-};
-Chords chords(const Element& e, double s0, double s1) {
-    Chords c;
-    c.count = e.kind == ElementKind::Line ? 1 : kDeviationChords;
-    CurvePoint cp;
-    for (int i = 0; i <= c.count; ++i) {
-        evaluate(e, s0 + (s1 - s0) * i / c.count, cp);
-        c.pts[i] = cp.p;
-    }
-    if (e.kind == ElementKind::Arc) {
-        double h = (s1 - s0) / c.count;
-        c.sagitta_mm = h * h / (8 * e.radius_mm);
-    }
-    return c;
-}
-
-// Squared distance from q to the chain, through the two chords beside its nearest vertex. Where
-// that misses the nearest chord the result is larger than the true distance: the deviation
-// check stays on the safe side.
-double chain_dist2(const AxisArray& q, const Chords& c) {
-    int near = 0;
-    double best = kInf;
-    for (int i = 0; i <= c.count; ++i) {
-        double d = dist2(q, c.pts[i]);
-        if (d < best) best = d, near = i;
-    }
-    if (near > 0) best = std::min(best, segment_dist2(q, c.pts[near - 1], c.pts[near]));
-    if (near < c.count) best = std::min(best, segment_dist2(q, c.pts[near], c.pts[near + 1]));
-    return best;
-}
-
-// Largest distance of the blend from the two programmed moves near their corner (an upper
-// bound up to the sampling: only the parts near the corner are searched, arcs are taken as
-// chords plus their bulge, and the largest of the samples is refined by a golden-section search
-// between its neighbours).
-// Stops early, returning a value above `limit_mm`, once a sample is beyond it.
-double blend_deviation_mm(const Element& blend, const Chords& before, const Chords& after,
-                          double limit_mm) {
-    const double bulge = std::max(before.sagitta_mm, after.sagitta_mm);
-    const double limit2 = limit_mm > bulge ? (limit_mm - bulge) * (limit_mm - bulge) : 0.0;
-    auto dist2_at = [&](double u) {
-        CurvePoint cp;
-        evaluate(blend, blend.length_mm * u, cp);
-        return std::min(chain_dist2(cp.p, before), chain_dist2(cp.p, after));
-    };
-    double worst = 0;
-    int at = 1;
-    for (int i = 1; i < kDeviationSamples; ++i) {
-        double d = dist2_at(double(i) / kDeviationSamples);
-        if (d > limit2) return std::sqrt(d) + bulge;
-        if (d > worst) worst = d, at = i;
-    }
-    const double g = (std::sqrt(5.0) - 1) / 2;
-    double lo = double(at - 1) / kDeviationSamples, hi = double(at + 1) / kDeviationSamples;
-    for (int it = 0; it < kDeviationRefine; ++it) {
-        double m1 = hi - g * (hi - lo), m2 = lo + g * (hi - lo);
-        double d1 = dist2_at(m1), d2 = dist2_at(m2);
-        worst = std::max({worst, d1, d2});
-        (d1 < d2 ? lo : hi) = d1 < d2 ? m1 : m2;
-    }
-    return std::sqrt(worst) + bulge;
-}
-
-// Distance h of a Bezier blend's inner control points from its ends p0, p3 along the unit
-// tangents t1, t2. The blend's pseudo length is 3 h and its speed |p'| must be 1 at both ends
-// (no speed step at the junctions), so the middle of the hodograph may not be longer:
-// |p3 - p0 - h (t1 + t2)| <= h. h0 = 2/3 of the cut (the parabola, for two lines) when that
-// holds, else the smallest larger h that does; 0 if none.
-double control_distance_mm(const AxisArray& p0, const AxisArray& t1, const AxisArray& p3,
-                           const AxisArray& t2, double h0) {
-    double dd = 0, ds = 0, ss = 0;
-    for (int k = 0; k < kAxes; ++k) {
-        double d = p3[k] - p0[k], sk = t1[k] + t2[k];
-        dd += d * d, ds += d * sk, ss += sk * sk;
-    }
-    // f(h) = (ss - 1) h^2 - 2 ds h + dd <= 0
-    auto f = [&](double h) { return (ss - 1) * h * h - 2 * ds * h + dd; };
-    if (f(h0) <= 0) return h0;
-    const double qa = ss - 1, disc = ds * ds - qa * dd;
-    if (std::fabs(qa) < 1e-12) return ds > 0 ? std::max(h0, dd / (2 * ds)) : 0.0;
-    if (disc < 0) return 0;
-    double r1 = (ds - std::sqrt(disc)) / qa, r2 = (ds + std::sqrt(disc)) / qa;
-    for (double r : {std::min(r1, r2), std::max(r1, r2)})
-        if (r > h0 && f(r * (1 + 1e-12)) <= 1e-12 * dd) return r * (1 + 1e-12);
-    return 0;
-}
-
 }  // namespace
 
 Planner::Junction Planner::bezier_corner(const Piece& p, const Piece& next, double sin_angle,
@@ -341,23 +224,16 @@ Planner::Junction Planner::bezier_corner(const Piece& p, const Piece& next, doub
     double l = std::min(l_max, tol / (kParabolaDeviationPerL * sin_angle));
     const double L1 = p.geom.length_mm;
     double reach = std::min(l_max, kDeviationReach * l);
-    const Chords before = chords(p.geom, L1 - reach, L1);
-    const Chords after = chords(next.geom, 0, reach);
+    const double allowed_mm = kDeviationMargin * tol;
+    const CornerPath path = corner_path(p.geom, reach, next.geom, reach, allowed_mm);
     for (int attempt = 0; attempt < kBlendAttempts && l > kMinLength_mm; ++attempt, l *= 0.7) {
         CurvePoint a, b;
         evaluate(p.geom, L1 - l, a);
         evaluate(next.geom, l, b);
-        double h = control_distance_mm(a.p, a.d1, b.p, b.d1, 2.0 / 3 * l);
-        if (!(h > 0)) continue;
-        AxisArray c1, c2;
-        for (int k = 0; k < kAxes; ++k) {
-            c1[k] = a.p[k] + h * a.d1[k];
-            c2[k] = b.p[k] - h * b.d1[k];
-        }
+        std::optional<Element> curve = make_corner_bezier(a.p, a.d1, b.p, b.d1, l);
+        if (!curve || !bezier_within(*curve, path, allowed_mm)) continue;
         Junction jn{kInf, false, l, Blend::Curve};
-        jn.curve = make_bezier(a.p, c1, c2, b.p);
-        const double allowed_mm = kDeviationMargin * tol;
-        if (blend_deviation_mm(jn.curve, before, after, allowed_mm) > allowed_mm) continue;
+        jn.curve = *curve;
         jn.curve_end_cap_mm_s = kInf;
         if (!jerk_mode_) return jn;  // without a jerk limit curvature steps cost nothing
         EndDerivs bs = start_derivs(jn.curve), be = end_derivs(jn.curve);

@@ -21,7 +21,9 @@
 // a cubic with P1 = P0 + 2/3 (C - P0), P2 = P3 + 2/3 (C - P3)), and for corners with arcs.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <optional>
 
 #include "motion/types.hpp"
 
@@ -92,5 +94,35 @@ Element trim_arc(const Element& arc, double from_mm, double to_mm) noexcept;
 
 // The line element trimmed to [from_mm, length - to_mm] of the original.
 Element trim_line(const Element& line, double from_mm, double to_mm) noexcept;
+
+// Corner blend for corners with an arc: a Bezier from p0 (unit tangent t1 there) to p3 (unit
+// tangent t2), its inner control points h along the tangents with h = 2/3 l (the parabola's, l
+// being the cut from each move), or the smallest larger h for which |p'| = 1 at both ends and
+// <= 1 inside (|p3 - p0 - h (t1 + t2)| <= h). None if no h fits.
+std::optional<Element> make_corner_bezier(const AxisArray& p0, const AxisArray& t1,
+                                          const AxisArray& p3, const AxisArray& t2,
+                                          double l_mm) noexcept;
+
+// The programmed path near a corner, for proving a blend's distance from it: the last
+// `before_mm` of `before` and the first `after_mm` of `after` as chords, each with `slack_mm`,
+// how far the path between its ends may lie from it (0 for a line; for an arc or helix
+// R dphi^2 / 8, the bound of linear interpolation's error by max |p''| / 8). Arcs get enough
+// chords (at most kMaxChordsPerMove) for a slack below 2 % of the distance to be proved.
+struct CornerPath {
+    static constexpr int kMaxChordsPerMove = 8;
+    static constexpr int kMaxChords = 2 * kMaxChordsPerMove;
+    std::array<AxisArray, kMaxChords> from{}, dir{};  // chord start, end - start
+    std::array<double, kMaxChords> inv_len2{}, slack_mm{};
+    int count = 0;
+};
+CornerPath corner_path(const Element& before, double before_mm, const Element& after,
+                       double after_mm, double limit_mm) noexcept;
+
+// True only if every point of the Bezier element is within limit_mm of the path: the curve is
+// split in halves (de Casteljau) until each piece's control points, whose hull holds the piece,
+// lie within limit_mm - slack of one chord (the distance to a segment is convex, so the hull's
+// farthest point is a control point). Gives up (false) at once when a split point cannot be
+// within reach of any chord, or after 6 levels of splitting. Noexcept, no allocation.
+bool bezier_within(const Element& bezier, const CornerPath& path, double limit_mm) noexcept;
 
 }  // namespace motion
