@@ -292,7 +292,6 @@ Element trim_line(const Element& line, double from, double to) noexcept {
     return e;
 }
 
-
 std::optional<Element> make_corner_bezier(const AxisArray& p0, const AxisArray& t1,
                                           const AxisArray& p3, const AxisArray& t2,
                                           double l) noexcept {
