@@ -335,7 +335,25 @@ constexpr double kChordSlackShare = 0.02;
 // Halvings of a blend before bezier_within gives up (2^6 pieces).
 constexpr int kMaxSplitDepth = 6;
 
-void add_chords(CornerPath& path, const Element& e, double s0, double s1, double limit_mm) {
+// Whether e changes axis k anywhere.
+bool moves_axis(const Element& e, int k) {
+    switch (e.kind) {
+        case ElementKind::Line:
+            return e.a[k] != 0;
+        case ElementKind::Arc:
+            return e.a[k] != 0 || e.b[k] != 0 || e.c[k] != 0;
+        case ElementKind::Blend:
+            return e.a[k] != 0 || e.b[k] != 0;
+        case ElementKind::Bezier:
+            return e.a[k] != e.origin[k] || e.b[k] != e.origin[k] || e.end[k] != e.origin[k];
+    }
+    return true;
+}
+
+// Chords of e over [s0, s1]; `known` is the point at `known_s` (s0 or s1), which saves an
+// evaluation: the corner point both moves share.
+void add_chords(CornerPath& path, const Element& e, double s0, double s1, double known_s,
+                const AxisArray& known, double limit_mm) {
     int n = 1;
     double slack = 0;
     if (e.kind == ElementKind::Arc) {
@@ -344,68 +362,97 @@ void add_chords(CornerPath& path, const Element& e, double s0, double s1, double
         n = std::clamp(int(std::ceil(want)), 1, CornerPath::kMaxChordsPerMove);
         slack = e.radius_mm * (dphi / n) * (dphi / n) / 8;
     }
-    CurvePoint a, b;
-    evaluate(e, s0, a);
+    auto point = [&](int i, AxisArray& out) {
+        double s = i == n ? s1 : s0 + (s1 - s0) * i / n;
+        if (s == known_s) {
+            out = known;
+            return;
+        }
+        CurvePoint cp;
+        evaluate(e, s, cp);
+        out = cp.p;
+    };
+    AxisArray a, b;
+    point(0, a);
     for (int i = 1; i <= n; ++i, a = b) {
-        evaluate(e, i == n ? s1 : s0 + (s1 - s0) * i / n, b);
+        point(i, b);
         const int c = path.count++;
         double len2 = 0;
-        for (int k = 0; k < kAxes; ++k) {
-            path.from[c][k] = a.p[k];
-            path.dir[c][k] = b.p[k] - a.p[k];
-            len2 += path.dir[c][k] * path.dir[c][k];
+        for (int j = 0; j < path.dims; ++j) {
+            const int k = path.axes[j];
+            path.from[c][j] = a[k];
+            path.dir[c][j] = b[k] - a[k];
+            len2 += path.dir[c][j] * path.dir[c][j];
         }
         path.inv_len2[c] = len2 > 0 ? 1 / len2 : 0;
         path.slack_mm[c] = slack;
     }
 }
 
-// Squared distance from q to chord c.
-double chord_dist2(const CornerPath& path, int c, const AxisArray& q) {
-    const AxisArray &a = path.from[c], &d = path.dir[c];
-    double t = 0;
-    for (int k = 0; k < kAxes; ++k) t += (q[k] - a[k]) * d[k];
-    t = std::clamp(t * path.inv_len2[c], 0.0, 1.0);
-    double r = 0;
-    for (int k = 0; k < kAxes; ++k) {
-        double x = q[k] - a[k] - t * d[k];
-        r += x * x;
-    }
-    return r;
-}
+// A Bezier piece's control points: first in the path's axes, then (relative to the path's
+// fixed value) in the axes only the blend moves.
+using Hull = std::array<AxisArray, 4>;
 
-using Hull = std::array<AxisArray, 4>;  // a Bezier piece's control points
+// What bezier_within works with: the path, the limit, the dimensions of the hull points, and
+// the squared distance from the path in the axes neither moves (the same for all points).
+struct Proof {
+    const CornerPath& path;
+    double limit_mm;
+    double still_axes2;
+    int dims;  // path.dims, then the blend's own axes up to `dims`
 
-// Whether all of the piece's control points lie within limit - slack of chord c.
-bool hull_near_chord(const CornerPath& path, int c, const Hull& q, double limit_mm) {
-    double room = limit_mm - path.slack_mm[c];
-    if (room <= 0) return false;
-    for (const AxisArray& p : q)
-        if (chord_dist2(path, c, p) > room * room) return false;
-    return true;
-}
-
-// Tries the chord that held the previous piece first: the pieces follow the path in order.
-bool hull_near_path(const CornerPath& path, const Hull& q, double limit_mm, int& hint) {
-    for (int c = hint; c < path.count; ++c)
-        if (hull_near_chord(path, c, q, limit_mm)) return hint = c, true;
-    for (int c = hint - 1; c >= 0; --c)
-        if (hull_near_chord(path, c, q, limit_mm)) return hint = c, true;
-    return false;
-}
-
-// A curve point that no chord holds within limit - slack: no piece through it can be proved.
-bool beyond_reach(const CornerPath& path, const AxisArray& p, double limit_mm) {
-    for (int c = 0; c < path.count; ++c) {
+    // Squared room left for the distance in the other axes to chord c (< 0: none).
+    double room2(int c) const {
         double room = limit_mm - path.slack_mm[c];
-        if (room > 0 && chord_dist2(path, c, p) <= room * room) return false;
+        return room > 0 ? room * room - still_axes2 : -1;
     }
-    return true;
-}
+
+    double chord_dist2(int c, const AxisArray& q) const {
+        const AxisArray &a = path.from[c], &d = path.dir[c];
+        const int n = path.dims;
+        double t = 0;
+        for (int k = 0; k < n; ++k) t += (q[k] - a[k]) * d[k];
+        t = std::clamp(t * path.inv_len2[c], 0.0, 1.0);
+        double r = 0;
+        for (int k = 0; k < n; ++k) {
+            double x = q[k] - a[k] - t * d[k];
+            r += x * x;
+        }
+        for (int k = n; k < dims; ++k) r += q[k] * q[k];  // the chord has 0 there
+        return r;
+    }
+
+    // Whether all of the piece's control points lie within reach of chord c.
+    bool hull_near_chord(int c, const Hull& q) const {
+        const double r2 = room2(c);
+        if (r2 < 0) return false;
+        for (const AxisArray& p : q)
+            if (chord_dist2(c, p) > r2) return false;
+        return true;
+    }
+
+    // Tries the chord that held the previous piece first: the pieces follow the path in order.
+    bool hull_near_path(const Hull& q, int& hint) const {
+        for (int c = hint; c < path.count; ++c)
+            if (hull_near_chord(c, q)) return hint = c, true;
+        for (int c = hint - 1; c >= 0; --c)
+            if (hull_near_chord(c, q)) return hint = c, true;
+        return false;
+    }
+
+    // A curve point out of reach of every chord: no piece through it can be proved.
+    bool beyond_reach(const AxisArray& p) const {
+        for (int c = 0; c < path.count; ++c) {
+            const double r2 = room2(c);
+            if (r2 >= 0 && chord_dist2(c, p) <= r2) return false;
+        }
+        return true;
+    }
+};
 
 // de Casteljau at u = 1/2.
-void split_half(const Hull& q, Hull& left, Hull& right) {
-    for (int k = 0; k < kAxes; ++k) {
+void split_half(const Hull& q, Hull& left, Hull& right, int dims) {
+    for (int k = 0; k < dims; ++k) {
         double p01 = (q[0][k] + q[1][k]) / 2, p12 = (q[1][k] + q[2][k]) / 2,
                p23 = (q[2][k] + q[3][k]) / 2;
         double p012 = (p01 + p12) / 2, p123 = (p12 + p23) / 2;
@@ -420,21 +467,43 @@ void split_half(const Hull& q, Hull& left, Hull& right) {
 CornerPath corner_path(const Element& before, double before_mm, const Element& after,
                        double after_mm, double limit_mm) noexcept {
     CornerPath path;
+    for (int k = 0; k < kAxes; ++k) {
+        path.moving[k] = moves_axis(before, k) || moves_axis(after, k);
+        if (path.moving[k])
+            path.axes[path.dims++] = k;
+        else
+            path.fixed[k] = before.end[k];
+    }
     const double len = before.length_mm;
-    add_chords(path, before, std::max(0.0, len - before_mm), len, limit_mm);
-    add_chords(path, after, 0, std::min(after_mm, after.length_mm), limit_mm);
+    add_chords(path, before, std::max(0.0, len - before_mm), len, len, before.end, limit_mm);
+    add_chords(path, after, 0, std::min(after_mm, after.length_mm), 0, before.end, limit_mm);
     return path;
 }
 
 bool bezier_within(const Element& bezier, const CornerPath& path, double limit_mm) noexcept {
+    const std::array<const AxisArray*, 4> ctrl{&bezier.origin, &bezier.a, &bezier.b, &bezier.end};
+    Hull piece;
+    for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < path.dims; ++j) piece[i][j] = (*ctrl[i])[path.axes[j]];
+    int dims = path.dims;
+    double still_axes2 = 0;
+    for (int k = 0; k < kAxes; ++k) {
+        if (path.moving[k]) continue;
+        if (moves_axis(bezier, k)) {
+            for (int i = 0; i < 4; ++i) piece[i][dims] = (*ctrl[i])[k] - path.fixed[k];
+            ++dims;
+        } else {
+            still_axes2 += (bezier.origin[k] - path.fixed[k]) * (bezier.origin[k] - path.fixed[k]);
+        }
+    }
+    const Proof proof{path, limit_mm, still_axes2, dims};
     // Depth-first over the halvings: `pending` holds the right halves still to be proved.
     std::array<Hull, kMaxSplitDepth + 1> pending;
     std::array<int, kMaxSplitDepth + 1> pending_depth{};
     int top = 0, depth = 0, hint = 0;
-    Hull piece{bezier.origin, bezier.a, bezier.b, bezier.end};
     for (;;) {
         // The whole blend spans both moves: start with its halves.
-        if (depth > 0 && hull_near_path(path, piece, limit_mm, hint)) {
+        if (depth > 0 && proof.hull_near_path(piece, hint)) {
             if (top == 0) return true;
             --top;
             piece = pending[top];
@@ -443,8 +512,8 @@ bool bezier_within(const Element& bezier, const CornerPath& path, double limit_m
         }
         if (depth == kMaxSplitDepth) return false;
         Hull left;
-        split_half(piece, left, pending[top]);
-        if (beyond_reach(path, left[3], limit_mm)) return false;
+        split_half(piece, left, pending[top], dims);
+        if (proof.beyond_reach(left[3])) return false;
         pending_depth[top++] = ++depth;
         piece = left;
     }

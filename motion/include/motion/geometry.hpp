@@ -104,15 +104,23 @@ std::optional<Element> make_corner_bezier(const AxisArray& p0, const AxisArray& 
                                           double l_mm) noexcept;
 
 // The programmed path near a corner, for proving a blend's distance from it: the last
-// `before_mm` of `before` and the first `after_mm` of `after` as chords, each with `slack_mm`,
-// how far the path between its ends may lie from it (0 for a line; for an arc or helix
-// R dphi^2 / 8, the bound of linear interpolation's error by max |p''| / 8). Arcs get enough
-// chords (at most kMaxChordsPerMove) for a slack below 2 % of the distance to be proved.
+// `before_mm` of `before` and the first `after_mm` of `after` (which starts where `before`
+// ends) as chords, each with `slack_mm`, how far the path between its ends may lie from it (0
+// for a line; for an arc or helix R dphi^2 / 8, the bound of linear interpolation's error by
+// max |p''| / 8). Arcs get enough chords (at most kMaxChordsPerMove) for a slack below 2 % of
+// the distance to be proved. Only the axes either move changes are kept (`axes`); in the
+// others the path stays at `fixed`.
 struct CornerPath {
     static constexpr int kMaxChordsPerMove = 8;
     static constexpr int kMaxChords = 2 * kMaxChordsPerMove;
-    std::array<AxisArray, kMaxChords> from{}, dir{};  // chord start, end - start
-    std::array<double, kMaxChords> inv_len2{}, slack_mm{};
+    std::array<int, kAxes> axes{};
+    int dims = 0;
+    std::array<bool, kAxes> moving{};
+    AxisArray fixed{};
+    // Only the first `count` chords are set (left uninitialised: this is built for every
+    // corner with an arc, and clearing 2 kB cost as much as the proof).
+    std::array<AxisArray, kMaxChords> from, dir;  // chord start, end - start, in `axes`
+    std::array<double, kMaxChords> inv_len2, slack_mm;
     int count = 0;
 };
 CornerPath corner_path(const Element& before, double before_mm, const Element& after,
