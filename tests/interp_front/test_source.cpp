@@ -157,3 +157,21 @@ TEST(SourceScan, DuplicateSequenceNumbersPerProgram) {
     EXPECT_EQ(d[1].line, 7);
     EXPECT_EQ(d[1].col, 2);
 }
+
+// LEX-07: the whole range the parser accepts for N (to 9e15) is checked, not only the bitmap's
+// 2^22; each program scope starts afresh there too.
+TEST(SourceScan, DuplicateLargeSequenceNumbers) {
+    auto s = Source::from_string("d.nc",
+                                 "N4194304\nN4194303\nN0004194304 X1\nN9000000000000000\n"
+                                 "N9000000000000000\nO7\nN4194304\nN4194305\nM17\n");
+    const auto& d = s->duplicate_sequences();
+    ASSERT_EQ(d.size(), 2u);
+    EXPECT_EQ(d[0].n, 4194304);
+    EXPECT_EQ(d[0].line, 3);
+    EXPECT_EQ(d[0].col, 1);
+    EXPECT_EQ(d[1].n, 9000000000000000);
+    EXPECT_EQ(d[1].line, 5);
+    // Past the parser's range an N is an error of its own, never a duplicate.
+    auto big = Source::from_string("b.nc", "N99999999999999999\nN99999999999999999\n");
+    EXPECT_TRUE(big->duplicate_sequences().empty());
+}

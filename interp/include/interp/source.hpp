@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <unordered_set>
 #include <vector>
 
 #include "interp/block.hpp"
@@ -64,10 +65,11 @@ class Source {
     std::optional<LabelSite> find_label(std::int64_t number) const;
     std::optional<LabelSite> find_label(std::string_view name) const;
     std::size_t label_count() const { return numbered_.size() + named_.size(); }
-    // Duplicate sequence numbers found by the same scan (the first kMaxDuplicates; N values
-    // of kMaxTrackedSequence and above are not tracked).
+    // Duplicate sequence numbers found by the same scan (the first kMaxDuplicates), over the
+    // whole range the parser accepts for N (to_integer: up to 9e15).
     static constexpr std::size_t kMaxDuplicates = 100;
-    static constexpr std::int64_t kMaxTrackedSequence = std::int64_t{1} << 22;
+    static constexpr std::int64_t kMaxSequence = 9'000'000'000'000'000;
+    static constexpr std::int64_t kBitmapSequences = std::int64_t{1} << 22;
     const std::vector<DuplicateSequence>& duplicate_sequences() const { return duplicates_; }
 
   private:
@@ -94,10 +96,11 @@ class Source {
     std::map<std::int64_t, LabelSite> numbered_;
     std::map<std::string, LabelSite, std::less<>> named_;  // upper-cased names
     // Sequence numbers of the current program scope during the scan: a bitmap (grown to the
-    // largest N seen, at most kMaxTrackedSequence bits = 512 KiB) and the words of it that were
-    // set, so the next label clears only those.
+    // largest N seen, at most kBitmapSequences bits = 512 KiB) and the words of it that were
+    // set, so the next label clears only those; N values past the bitmap go to a hash set.
     std::vector<std::uint64_t> seq_bits_;
     std::vector<std::uint32_t> seq_touched_;
+    std::unordered_set<std::int64_t> seq_large_;
     std::vector<DuplicateSequence> duplicates_;
 };
 

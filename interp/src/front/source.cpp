@@ -121,9 +121,15 @@ void Source::index_sequence(std::string_view line, std::size_t at, int line_numb
     if (i >= line.size() || !is_digit(line[i])) return;
     std::int64_t n = 0;
     while (i < line.size() && is_digit(line[i])) {
+        // Past this the parser rejects the N word anyway ("out of range"); it is no duplicate.
+        if (n > kMaxSequence / 10) return;
         n = n * 10 + (line[i] - '0');
-        if (n >= kMaxTrackedSequence) return;
         ++i;
+    }
+    if (n >= kBitmapSequences) {  // rare: a hash set keeps the bitmap small
+        if (!seq_large_.insert(n).second && duplicates_.size() < kMaxDuplicates)
+            duplicates_.push_back({n, line_number, static_cast<int>(at) + 1});
+        return;
     }
     const std::size_t word = static_cast<std::size_t>(n) / 64;
     const std::uint64_t bit = std::uint64_t{1} << (n % 64);
@@ -140,6 +146,7 @@ void Source::index_sequence(std::string_view line, std::size_t at, int line_numb
 void Source::begin_sequence_scope() {
     for (std::uint32_t w : seq_touched_) seq_bits_[w] = 0;
     seq_touched_.clear();
+    if (!seq_large_.empty()) seq_large_.clear();
 }
 
 void Source::index_line(std::string_view line, SourcePos pos) {
@@ -200,6 +207,7 @@ void Source::index_labels() {
     // The scan's bookkeeping is not needed while the program runs.
     seq_bits_ = {};
     seq_touched_ = {};
+    seq_large_ = {};
     seek(SourcePos{});
 }
 
