@@ -30,6 +30,7 @@ struct CommonOptions {
     bool save_settings = false;
     bool optional_stop = false;
     bool no_g00_split = false;
+    bool use_default_speed = false;
     double default_feed_mm_min = 0;
     std::vector<std::string> g904_trips;
 };
@@ -54,6 +55,9 @@ void add_common(CLI::App& cmd, CommonOptions& o) {
     cmd.add_option("--default-feed", o.default_feed_mm_min,
                    "machine default feed (mm/min) for feed moves before any F; 0 = error")
         ->check(CLI::NonNegativeNumber);
+    cmd.add_flag("--use-default-speed", o.use_default_speed,
+                 "NcStudio \"use default speed\": moves run at --default-feed and the machine's "
+                 "rapid speed whatever F says; only G905 blocks use the programmed F");
     cmd.add_option("--g904-trip", o.g904_trips,
                    "AXIS=MM: machine coordinate where a G904 input changes (simulation)");
     cmd.add_flag("--no-g00-split", o.no_g00_split,
@@ -79,6 +83,9 @@ Session make_session(const CommonOptions& o) {
     s.cfg.optional_stop = o.optional_stop;
     s.cfg.g00_z_split = !o.no_g00_split;
     s.cfg.default_feed_mm_s = o.default_feed_mm_min / 60.0;
+    s.cfg.use_default_speed = o.use_default_speed;
+    if (o.use_default_speed && o.default_feed_mm_min <= 0)
+        throw std::runtime_error("--use-default-speed needs --default-feed MM_PER_MIN");
     s.iopts.dialect = interp::find_dialect(o.dialect);
     for (const std::string& t : o.g904_trips) {
         const auto eq = t.find('=');

@@ -39,6 +39,10 @@ struct BackendConfig {
     // The machine's default cutting feed, used by a feed move when no F was ever programmed
     // (NcStudio always has one; the manual's examples rely on it). 0 = such a move is an error.
     double default_feed_mm_s = 0;
+    // G00-4, cfg:ncstudio_use_default_speed (S0 §3.10 G905, "使用缺省速度"): feed moves run at
+    // default_feed_mm_s and rapids at the machine's rapid speed whatever F the program writes;
+    // only a G905 block runs at the programmed F. Needs default_feed_mm_s > 0.
+    bool use_default_speed = false;
     AxisVec reference_mm{};        // G28 reference point, machine coordinates
     AxisVec home_position_mm{};    // M902: machine origin position parameter per axis
     std::uint64_t input_bits = 0;  // standalone model of the input ports

@@ -30,10 +30,17 @@ struct UnitsModal {
 };
 
 // NcStudio keeps two feed registers (FEATURES G00-3): F in a G00 block sets the rapid speed only.
-struct FeedModal {
+struct FeedRegisters {
     double feed_mm_s = 0;
     bool feed_set = false;
-    double rapid_mm_s = 0;  // 0 = machine maximum
+    double rapid_mm_s = 0;  // 0 = the machine's rapid ("idle travel") speed
+};
+
+// The rates the stream has announced, which the moves run at. Normally they are the program's F
+// registers; with the machine's "use default speed" parameter on (G00-4) they are the machine's
+// defaults, and the program's F words only fill `programmed`, which a G905 block runs at.
+struct FeedModal : FeedRegisters {
+    FeedRegisters programmed;
 };
 
 struct SpindleModal {

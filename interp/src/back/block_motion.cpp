@@ -21,6 +21,7 @@ AxisVec BlockRun::programmed_target() const {
 
 // NcStudio G00 (G00-2): when Z rises, Z moves first; when it falls, the other axes move first.
 void BlockRun::emit_rapid(const AxisVec& end) {
+    if (cfg_.use_default_speed) select_rapid();
     const AxisVec& start = st.pos.machine_mm;
     constexpr double eps = 1e-9;
     const double dz = end[2] - start[2];
@@ -36,7 +37,33 @@ void BlockRun::emit_rapid(const AxisVec& end) {
     st.pos.machine_mm = end;
 }
 
+// G00-4: with "use default speed" on, a move runs at the machine's default feed / rapid speed,
+// in a G905 block at the programmed ones; the stream announces a rate when it changes.
+void BlockRun::select_feed(const char* what) {
+    double f = cfg_.default_feed_mm_s;
+    if (flags_.force_programmed_feed) {
+        if (!st.feed.programmed.feed_set || st.feed.programmed.feed_mm_s <= 0)
+            fail(loc_g(gcode(905)), fmt::format("G905: no feed rate programmed (F) for {}", what));
+        f = st.feed.programmed.feed_mm_s;
+    } else if (f <= 0) {
+        fail(b_.loc,
+             fmt::format("no default feed configured for {} (use default speed is on)", what));
+    }
+    if (st.feed.feed_set && st.feed.feed_mm_s == f) return;
+    st.feed.feed_mm_s = f;
+    st.feed.feed_set = true;
+    emit(canon::SetFeedRate{f});
+}
+
+void BlockRun::select_rapid() {
+    const double r = flags_.force_programmed_feed ? st.feed.programmed.rapid_mm_s : 0.0;
+    if (st.feed.rapid_mm_s == r) return;
+    st.feed.rapid_mm_s = r;
+    emit(canon::SetRapidRate{r});
+}
+
 void BlockRun::require_feed(const char* what) {
+    if (cfg_.use_default_speed) return select_feed(what);
     if (st.feed.feed_set && st.feed.feed_mm_s > 0) return;
     if (!st.feed.feed_set && cfg_.default_feed_mm_s > 0) {
         st.feed.feed_mm_s = cfg_.default_feed_mm_s;
@@ -274,7 +301,7 @@ cycles::CycleConfig BlockRun::cycle_config() const {
 }
 
 void BlockRun::run_cycle() {
-    if (!st.feed.feed_set) require_feed("a canned cycle");
+    if (!st.feed.feed_set || cfg_.use_default_speed) require_feed("a canned cycle");
     std::optional<cycles::CycleCode> code;
     if (cycle_code_ && *cycle_code_ != gcode(80))
         code = cycles::cycle_code_from_g(*cycle_code_ / 10);
@@ -295,6 +322,7 @@ void BlockRun::run_hole_pattern() {
     if (b_.has('J')) w.j = code == gcode(37) ? mm('J') : b_.get('J');
     if (b_.has('P')) w.p = b_.get('P');
     if (b_.has('K')) w.k = b_.get('K');
+    if (cfg_.use_default_speed && st.cycle.active()) require_feed("a hole pattern");
     try {
         cycles::HolePattern holes =
             cycles::hole_pattern_lazy(code / 10, w, st.motion.incremental,
@@ -411,7 +439,12 @@ void BlockRun::program_end(bool rewind) {
         st.path = PathModal{};
         emit(canon::SetBlending{false, 0});
     }
-    st.feed.rapid_mm_s = 0;
+    // G00-3 REC: the programmed rapid speed ends with the program. Under G00-4 the announced one
+    // is the machine's own and stays in step with the stream.
+    if (cfg_.use_default_speed)
+        st.feed.programmed.rapid_mm_s = 0;
+    else
+        st.feed.rapid_mm_s = 0;
     st.tool.length_mode = ToolLengthMode::Off;
     st.tool.h_register.reset();
     const std::array<double, 3> before = st.tool.offset_mm;

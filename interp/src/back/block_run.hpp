@@ -173,6 +173,8 @@ class BlockRun {
     void require_no_scaling(int code) const;
     void require_no_mirror_coord_change() const;
     void require_feed(const char* what);
+    void select_feed(const char* what);
+    void select_rapid();
 
     void emit_rapid(const AxisVec& end);
     void move_line(bool rapid, bool machine_coords);

@@ -37,12 +37,16 @@ void BlockRun::step_feed() {
         (cycle_code_ && *cycle_code_ != gcode(80)) || (st.cycle.active() && !motion_code_);
     const bool rapid_mode = !cycle_block && (motion_code_ ? *motion_code_ == gcode(0)
                                                           : st.motion.motion == Motion::Rapid);
+    // G00-4: under "use default speed" F only fills the programmed registers; the rates a move
+    // runs at are announced when it is emitted (select_feed, select_rapid).
+    const bool announce = !cfg_.use_default_speed;
+    FeedRegisters& reg = announce ? st.feed : st.feed.programmed;
     if (rapid_mode && !g(gcode(904))) {
         double r = f_mm_s;
         if (cfg_.max_rapid_mm_s > 0) r = std::min(r, cfg_.max_rapid_mm_s);
-        st.feed.rapid_mm_s = r;
-        emit(canon::SetRapidRate{r});
-        if (st.feed.feed_set) return;  // G00-3 REC: a first bare F also primes the cutting feed
+        reg.rapid_mm_s = r;
+        if (announce) emit(canon::SetRapidRate{r});
+        if (reg.feed_set) return;  // G00-3 REC: a first bare F also primes the cutting feed
     }
     double cut_mm_s = f_mm_s;
     if (cfg_.max_feed_mm_s > 0 && cut_mm_s > cfg_.max_feed_mm_s) {
@@ -52,9 +56,9 @@ void BlockRun::step_feed() {
                                             fmt_num(f), fmt_num(cut_mm_s * 60.0))});
         st.feed_clamp_warned = true;
     }
-    st.feed.feed_mm_s = cut_mm_s;
-    st.feed.feed_set = true;
-    emit(canon::SetFeedRate{cut_mm_s});
+    reg.feed_mm_s = cut_mm_s;
+    reg.feed_set = true;
+    if (announce) emit(canon::SetFeedRate{cut_mm_s});
 }
 
 void BlockRun::step_spindle_speed() {
@@ -354,20 +358,32 @@ void BlockRun::step_transforms() {
         Eigen::Vector3d f(1, 1, 1);
         const SourceLoc loc = loc_g(gcode(51));
         if (cfg_.v54_compat) {
-            // SCL-4: I J K is the centre, P the factor for every axis (negative mirrors).
+            // SCL-4: I J K is the centre, P the factor (negative mirrors). S1 §3.3 says, like
+            // S0 of X Y Z, that an axis whose centre is omitted keeps its previous factor.
+            unsigned centre_mask = 0;
             for (int a = 0; a < 3; ++a)
-                if (b_.has(kCentreLetter[a]))
+                if (b_.has(kCentreLetter[a])) {
                     centre[a] = b_.get(kCentreLetter[a]) * st.units.mm_per_unit;
+                    centre_mask |= 1u << a;
+                }
+            if (centre_mask == 0)
+                fail(loc, "G51 P scales the axes whose centre (I J K) is written; none given");
+            // LEX-57: S1 allows 0.000001..99.999999, and the same range negated to mirror.
             const double p = b_.has('P') ? b_.get('P') : 1.0;
-            if (p == 0 || std::abs(p) > 99.999999)
-                fail(b_.has('P') ? b_.loc_of('P') : loc,
-                     fmt::format("G51: scale factor P{} out of range", fmt_num(p)));
-            f = Eigen::Vector3d(p, p, p);
+            if (p == 0) fail(b_.loc_of('P'), "G51: scale factor P is 0");
+            if (std::abs(p) < 0.000001 || std::abs(p) > 99.999999)
+                fail(b_.loc_of('P'),
+                     fmt::format("G51: scale factor P{} outside 0.000001..99.999999 (negative: "
+                                 "-0.000001..-99.999999, mirrors)",
+                                 p));
+            for (int a = 0; a < 3; ++a)
+                if (centre_mask & (1u << a)) f[a] = p;
         } else {
             const bool has_p = b_.has('P');
             const bool has_ijk = b_.has('I') || b_.has('J') || b_.has('K');
             if (has_p && has_ijk) fail(loc, "G51: use either P or I/J/K, not both");
             if (!has_p && !has_ijk) fail(loc, "G51 needs P<factor> or I/J/K factors");
+            // LEX-57 / SCL-3: S0 allows 0.000001..99.999999; 0 is the alarm the manual names.
             auto check = [&](char letter) {
                 const double v = b_.get(letter);
                 if (v == 0)
@@ -375,7 +391,7 @@ void BlockRun::step_transforms() {
                 if (v < 0.000001 || v > 99.999999)
                     fail(b_.loc_of(letter),
                          fmt::format("G51: scale factor {}{} outside 0.000001..99.999999", letter,
-                                     fmt_num(v)));
+                                     v));
                 return v;
             };
             if (has_p) {

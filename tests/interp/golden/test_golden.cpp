@@ -4,8 +4,8 @@
 //                with "format linuxcnc"), then "error: <message>" if the program must fail
 //   README.md    what was checked and how
 //   options      optional, one per line: dialect <name> | tool-table <file> | library <file> |
-//                default-feed <mm/min> | optional-stop | no-g00-split | format linuxcnc |
-//                settings <file> | g904-trip <X|Y|Z> <machine mm>
+//                default-feed <mm/min> | use-default-speed | optional-stop | no-g00-split |
+//                format linuxcnc | settings <file> | g904-trip <X|Y|Z> <machine mm>
 // The expected files were written and checked by hand or by geometry, never copied from output.
 #include <gtest/gtest.h>
 
@@ -50,7 +50,7 @@ struct CaseOptions {
     std::string tool_table, library, settings;
     std::array<std::optional<double>, 3> g904_trip_mm{};
     double default_feed_mm_min = 0;
-    bool optional_stop = false, no_split = false, linuxcnc = false;
+    bool optional_stop = false, no_split = false, linuxcnc = false, use_default_speed = false;
 };
 
 CaseOptions read_options(const fs::path& dir) {
@@ -73,6 +73,8 @@ CaseOptions read_options(const fs::path& dir) {
             o.g904_trip_mm[axis - 'X'] = mm;
         } else if (key == "default-feed")
             f >> o.default_feed_mm_min;
+        else if (key == "use-default-speed")
+            o.use_default_speed = true;
         else if (key == "optional-stop")
             o.optional_stop = true;
         else if (key == "no-g00-split")
@@ -102,6 +104,7 @@ std::string run_case(const fs::path& dir) {
     cfg.optional_stop = o.optional_stop;
     cfg.g00_z_split = !o.no_split;
     cfg.default_feed_mm_s = o.default_feed_mm_min / 60.0;
+    cfg.use_default_speed = o.use_default_speed;
     cfg.g904_trip_mm = o.g904_trip_mm;
     interp::InterpreterOptions iopts;
     iopts.dialect = interp::find_dialect(o.dialect);

@@ -80,6 +80,45 @@ TEST_F(ExecTest, G00_3_FInRapidBlockSetsRapidOnly) {
     EXPECT_EQ(run({"G01 X4 F300"}), (V{"feed-rate 5mm/s", "feed X4 Y0 Z0"}));
 }
 
+// G00-4 / NCX-2: with "use default speed" on, moves run at the machine's default feed (here
+// 1200 mm/min = 20 mm/s) and rapid speed (rapid-rate 0); F words only fill the programmed
+// registers, which a G905 block runs at. The stream re-announces a rate when it changes.
+TEST_F(ExecTest, G00_4_DefaultSpeedReplacesProgrammedF) {
+    BackendConfig cfg;
+    cfg.use_default_speed = true;
+    cfg.default_feed_mm_s = 20;
+    make(cfg);
+    EXPECT_EQ(run({"G01 X1 F600"}), (V{"feed-rate 20mm/s", "feed X1 Y0 Z0"}));
+    EXPECT_EQ(run({"G01 X2 F300"}), (V{"feed X2 Y0 Z0"}));
+    // The manual's example: G905 G903 G01 … F600 runs at exactly 600 mm/min = 10 mm/s.
+    EXPECT_EQ(run({"G905 G903 G01 X3 F600"}),
+              (V{"feed-rate 10mm/s", "feed X3 Y0 Z0 override=100% programmed-feed"}));
+    EXPECT_EQ(run({"G01 X4"}), (V{"feed-rate 20mm/s", "feed X4 Y0 Z0"}));
+    // G905 without F in its block: the last programmed F (600).
+    EXPECT_EQ(run({"G905 G02 X5 R0.5"}), (V{"feed-rate 10mm/s",
+                                            "arc XY turns=-1 X5 Y0 Z0 "
+                                            "centre=(4.5 0 0) programmed-feed"}));
+    // F in a G00 block fills the programmed rapid register only (G00-3).
+    EXPECT_EQ(run({"G00 X6 F3000"}), (V{"traverse X6 Y0 Z0"}));
+    EXPECT_EQ(run({"G905 G00 X7"}), (V{"rapid-rate 50mm/s", "traverse X7 Y0 Z0 programmed-feed"}));
+    EXPECT_EQ(run({"G00 X8"}), (V{"rapid-rate 0mm/s", "traverse X8 Y0 Z0"}));
+    EXPECT_EQ(run({"G01 X9"}), (V{"feed-rate 20mm/s", "feed X9 Y0 Z0"}));
+    EXPECT_DOUBLE_EQ(exec->state().feed.programmed.feed_mm_s, 10.0);
+}
+
+TEST_F(ExecTest, G00_4_DefaultSpeedErrors) {
+    BackendConfig cfg;
+    cfg.use_default_speed = true;
+    make(cfg);
+    EXPECT_EQ(error_of("G01 X1 F600"),
+              "test.nc:7:1: no default feed configured for a feed move (use default speed is on)");
+    cfg.default_feed_mm_s = 20;
+    make(cfg);
+    EXPECT_EQ(error_of("G905 G01 X1"),
+              "test.nc:7:1: G905: no feed rate programmed (F) for a feed move");
+    EXPECT_EQ(run({"G905 G01 X1 F60"}), (V{"feed-rate 1mm/s", "feed X1 Y0 Z0 programmed-feed"}));
+}
+
 TEST_F(ExecTest, FEED_8_FeedIsClampedWithOneWarningPerProgram) {
     BackendConfig cfg;
     cfg.max_feed_mm_s = 100;  // 6000 mm/min
@@ -197,6 +236,8 @@ TEST_F(ExecTest, UnsupportedCodesAreNamed) {
     EXPECT_EQ(error_of("G00 G33 X1"), "test.nc:7:5: unsupported G code G33");
     EXPECT_EQ(error_of("G12.1"), "test.nc:7:1: unsupported G code G12.1");
     EXPECT_EQ(error_of("M19"), "test.nc:7:1: unsupported M code M19");
+    // REF-8: S0 names G29 only among the codes forbidden under scaling; it is not provided.
+    EXPECT_EQ(error_of("G29 X0"), "test.nc:7:1: unsupported G code G29");
 }
 
 TEST_F(ExecTest, TwoAxisUsersInOneBlockIsAnError) {
@@ -230,7 +271,8 @@ TEST_F(ExecTest, RejectedBlockChangesNothing) {
 TEST_F(ExecTest, UNIT_1_InchInputIsConvertedToMm) {
     EXPECT_EQ(run({"G20 G00 X1 Y2"}), (V{"units inch", "traverse X25.4 Y50.8 Z0"}));
     // After the first move a unit change still applies, with the C-37 warning.
-    const std::string late = "warning \"G20/G21 after a move: units belong at the start of the program\"";
+    const std::string late =
+        "warning \"G20/G21 after a move: units belong at the start of the program\"";
     EXPECT_EQ(run({"G70 G01 X2 F10"}),
               (V{late, "feed-rate 4.2333mm/s", "units inch", "feed X50.8 Y50.8 Z0"}));
     EXPECT_EQ(run({"G71 G00 X1"}), (V{late, "units mm", "traverse X1 Y50.8 Z0"}));
@@ -335,10 +377,42 @@ TEST_F(ExecTest, SCL_3_BadFactorsAreErrors) {
     EXPECT_EQ(error_of("G51 X0 P0"), "test.nc:7:8: G51: scale factor P is 0");
     EXPECT_EQ(error_of("G51 X0 P100"),
               "test.nc:7:8: G51: scale factor P100 outside 0.000001..99.999999");
+    EXPECT_EQ(error_of("G51 X0 I0.0000005"),
+              "test.nc:7:8: G51: scale factor I5e-07 outside 0.000001..99.999999");
+    EXPECT_EQ(error_of("G51 X0 P-2"),
+              "test.nc:7:8: G51: scale factor P-2 outside 0.000001..99.999999");
     EXPECT_EQ(error_of("G51 X0 P2 I2"), "test.nc:7:1: G51: use either P or I/J/K, not both");
     EXPECT_EQ(error_of("G51 X0"), "test.nc:7:1: G51 needs P<factor> or I/J/K factors");
     EXPECT_EQ(error_of("G51 P2"),
               "test.nc:7:1: G51 P scales the axes written in the block; none given");
+}
+
+// LEX-57: the bounds themselves are allowed (S0 §3.5.1 "0.000001-99.999999").
+TEST_F(ExecTest, LEX_57_ScaleFactorBoundsAreAccepted) {
+    run({"G51 X0 Y0 P99.999999", "G00 X1"});
+    EXPECT_NEAR(exec->state().pos.machine_mm[0], 99.999999, 1e-9);
+    run({"G50", "G51 X0 Y0 P0.000001", "G00 X1000"});
+    EXPECT_NEAR(exec->state().pos.machine_mm[0], 0.001, 1e-12);
+}
+
+// LEX-57, SCL-4, MIR-6 (V5.4): P may also be -0.000001..-99.999999 (mirror and scale); 0 and
+// anything outside both ranges is an alarm.
+TEST_F(ExecTest, LEX_57_V54ScaleFactorRange) {
+    BackendConfig cfg;
+    cfg.v54_compat = true;
+    make(cfg);
+    EXPECT_EQ(error_of("G51 I0 J0 P0"), "test.nc:7:11: G51: scale factor P is 0");
+    const std::string range =
+        " outside 0.000001..99.999999 (negative: -0.000001..-99.999999, mirrors)";
+    EXPECT_EQ(error_of("G51 I0 J0 P100"), "test.nc:7:11: G51: scale factor P100" + range);
+    EXPECT_EQ(error_of("G51 I0 J0 P-100"), "test.nc:7:11: G51: scale factor P-100" + range);
+    EXPECT_EQ(error_of("G51 I0 J0 P0.0000005"), "test.nc:7:11: G51: scale factor P5e-07" + range);
+    EXPECT_EQ(error_of("G51 I0 J0 P-0.0000005"), "test.nc:7:11: G51: scale factor P-5e-07" + range);
+    // The negative bound mirrors: X 10 -> -10 * 99.999999 about the centre 0. Z has no centre
+    // word, so it keeps its factor 1 (S1 §3.3: omitted axes inherit the previous factor).
+    run({"G51 I0 J0 P-99.999999", "G00 X10 Y0 Z-3"});
+    EXPECT_NEAR(exec->state().pos.machine_mm[0], -999.99999, 1e-9);
+    EXPECT_NEAR(exec->state().pos.machine_mm[2], -3, 1e-12);
 }
 
 TEST_F(ExecTest, SCL_1_PerAxisFactorsIJK) {
@@ -412,6 +486,57 @@ TEST_F(ExecTest, MIR_1_MirrorLineAndArcDirectionFlip) {
 TEST_F(ExecTest, MIR_1_MirrorThroughAPoint) {
     run({"G51.1 X10 Y10 Z10", "G00 X0 Y0 Z0"});
     EXPECT_EQ(exec->state().pos.machine_mm, (AxisVec{20, 20, 20, 0, 0, 0}));
+}
+
+// LEX-11: A B C are rotary axes in degrees; G20 converts only the linear words, G91 adds.
+TEST_F(ExecTest, LEX_11_RotaryAxesABCInDegrees) {
+    EXPECT_EQ(run({"G00 A90 B-45 C30"}), (V{"traverse X0 Y0 Z0 A90 B-45 C30"}));
+    EXPECT_EQ(run({"G91 G00 A10 C-30", "G90"}), (V{"traverse X0 Y0 Z0 A100 B-45"}));
+    make();
+    run({"G20"});
+    EXPECT_EQ(run({"G00 X1 A10"}), (V{"traverse X25.4 Y0 Z0 A10"}));
+}
+
+// LEX-50: calculator notation, a value without a decimal point is in whole units (mm, mm/min).
+TEST_F(ExecTest, LEX_50_ValuesWithoutDecimalPointAreWholeUnits) {
+    EXPECT_EQ(run({"G00 X50 Y20."}), (V{"traverse X50 Y20 Z0"}));
+    EXPECT_EQ(run({"G01 X25 F600"}), (V{"feed-rate 10mm/s", "feed X25 Y20 Z0"}));
+}
+
+// PL-2: the plane selects arcs (and compensation), it does not restrict straight moves.
+TEST_F(ExecTest, PL_2_PlaneDoesNotRestrictAxisMotion) {
+    EXPECT_EQ(run({"G17 G00 Z5"}), (V{"plane XY", "traverse X0 Y0 Z5"}));
+    EXPECT_EQ(run({"G18 G00 X1 Y2 Z4"}), (V{"plane ZX", "traverse X1 Y2 Z5", "traverse X1 Y2 Z4"}));
+    EXPECT_EQ(run({"G19 G01 X3 Y4 Z6 F60"}), (V{"feed-rate 1mm/s", "plane YZ", "feed X3 Y4 Z6"}));
+}
+
+// SCL-6: scaling acts on the programmed contour only: work offsets and the tool length offset
+// are added unscaled afterwards (S0 §3.5.1 "比例功能对补偿值无效").
+TEST_F(ExecTest, SCL_6_ScalingLeavesOffsetsAndToolLengthAlone) {
+    Settings s;
+    s.offsets.wcs[0] = {100, 50, 0, 0, 0, 0};
+    s.tools.at(1).offset_mm = {0, 0, 12.5};
+    make({}, s);
+    // (10,5,-1) scaled by 2 about the work origin = (20,10,-2); + G54 (100,50,0); + tool Z12.5.
+    run({"G51 X0 Y0 Z0 P2", "G43 H1 G00 X10 Y5 Z-1"});
+    EXPECT_EQ(exec->state().pos.machine_mm, (AxisVec{120, 60, 10.5, 0, 0, 0}));
+}
+
+// ROT-10 / MIR-4: a rotation programmed while one plane axis is mirrored turns the other way on
+// the machine. Program (0,10) turned +90° is (-10,0); X mirrored about 0 gives (10,0), which is
+// the mirror image of (0,10) — itself (0,10) — turned by -90°, clockwise.
+TEST_F(ExecTest, ROT_10_OneMirroredAxisReversesTheRotation) {
+    run({"G51.1 X0", "G68 X0 Y0 R90", "G00 X0 Y10"});
+    EXPECT_NEAR(exec->state().pos.machine_mm[0], 10, 1e-9);
+    EXPECT_NEAR(exec->state().pos.machine_mm[1], 0, 1e-9);
+    // Both plane axes mirrored is a half turn, not a reflection: the rotation keeps its sense.
+    make();
+    run({"G51.1 X0 Y0", "G68 X0 Y0 R90", "G00 X0 Y10"});
+    EXPECT_NEAR(exec->state().pos.machine_mm[0], 10, 1e-9);  // (-10,0) -> (10,0)
+    EXPECT_NEAR(exec->state().pos.machine_mm[1], 0, 1e-9);
+    run({"G00 X10 Y0"});  // (10,0) -> (0,10) -> (0,-10): the half-turned image of (10,0) +90°
+    EXPECT_NEAR(exec->state().pos.machine_mm[0], 0, 1e-9);
+    EXPECT_NEAR(exec->state().pos.machine_mm[1], -10, 1e-9);
 }
 
 TEST_F(ExecTest, TLC_EX11_LengthOffsetAddsToZ) {
@@ -489,6 +614,16 @@ TEST_F(ExecTest, M30_1_EndResetsModalStateAndStopsSpindle) {
     EXPECT_EQ(run({"M02"}).back(), "program-end");
 }
 
+// TLC-6 REC (and END-1): length compensation is cancelled at program end.
+TEST_F(ExecTest, TLC_6_LengthCompEndsWithTheProgram) {
+    Settings s;
+    s.tools.at(1).offset_mm = {0, 0, 12.5};
+    make({}, s);
+    run({"G43 H1"});
+    EXPECT_EQ(run({"M30"}), (V{"tool-offset X0 Y0 Z0", "program-end rewind"}));
+    EXPECT_EQ(exec->state().tool.length_mode, ToolLengthMode::Off);
+}
+
 TEST_F(ExecTest, REF_2_G28ThroughIntermediatePoint) {
     BackendConfig cfg;
     cfg.reference_mm = {0, 0, 50, 0, 0, 0};
@@ -508,6 +643,22 @@ TEST_F(ExecTest, MCS_1_G53MovesInMachineCoordinates) {
     // Non-modal: the next move is in G54 again.
     EXPECT_EQ(run({"G00 X0"}), (V{"traverse X100 Y6 Z0"}));
     EXPECT_EQ(error_of("G91 G53 G00 X1"), "test.nc:7:5: G53 needs absolute coordinates (G90)");
+}
+
+// MCS-3 REC (NC default): G53 ignores the work offsets but keeps tool length compensation.
+TEST_F(ExecTest, MCS_3_LengthCompStaysActiveUnderG53) {
+    Settings s;
+    s.offsets.wcs[0] = {100, 100, 50, 0, 0, 0};
+    s.tools.at(1).offset_mm = {0, 0, 12.5};
+    make({}, s);
+    run({"G43 H1"});
+    EXPECT_EQ(run({"G53 G00 X5 Y6 Z-20"}), (V{"traverse X5 Y6 Z0", "traverse X5 Y6 Z-7.5"}));
+}
+
+// UNIT-4 / END-3 REC: NcStudio starts metric; G21/G71 are the metric codes, G20/G70 inch.
+TEST_F(ExecTest, UNIT_4_MetricIsTheDefault) {
+    EXPECT_DOUBLE_EQ(exec->state().units.mm_per_unit, 1.0);
+    EXPECT_EQ(run({"G00 X2"}), (V{"traverse X2 Y0 Z0"}));
 }
 
 TEST_F(ExecTest, M801_M802_Messages) {
@@ -556,6 +707,7 @@ TEST_F(ExecTest, FM_3_G94IsAcceptedAsFeedPerMinute) {
     EXPECT_EQ(run({"G94 G01 X1 F60"}),
               (V{"feed-mode per-minute", "feed-rate 1mm/s", "feed X1 Y0 Z0"}));
     EXPECT_EQ(error_of("G93 G01 X2"), "test.nc:7:1: unsupported G code G93");
+    EXPECT_EQ(error_of("G95 G01 X2"), "test.nc:7:1: unsupported G code G95");
 }
 
 TEST_F(ExecTest, NCX_3_G904ConditionalMove) {
