@@ -51,3 +51,18 @@ file(READ ${WORK}/bad.txt bad)
 if(NOT bad STREQUAL "g92 1 2\n")
   message(FATAL_ERROR "bad settings file was changed")
 endif()
+# --use-default-speed (G00-4): the default feed replaces F600; G905 runs at the programmed F.
+execute_process(COMMAND ${CNC} canon default_speed.nc --default-feed 1200 --use-default-speed
+                WORKING_DIRECTORY ${CASES} RESULT_VARIABLE status OUTPUT_VARIABLE out
+                ERROR_VARIABLE err)
+set(want "1 feed-rate 20mm/s\n1 feed X10 Y0 Z0\n2 feed-rate 10mm/s\n2 feed X20 Y0 Z0 programmed-feed\n")
+string(FIND "${out}" "${want}" at)
+if(NOT status EQUAL 0 OR at EQUAL -1)
+  message(FATAL_ERROR "cnc canon --use-default-speed: exit ${status}\n${out}\n${err}")
+endif()
+# Without a default feed the switch has nothing to run at: a setup error before anything runs.
+execute_process(COMMAND ${CNC} check default_speed.nc --use-default-speed
+                WORKING_DIRECTORY ${CASES} RESULT_VARIABLE status OUTPUT_QUIET ERROR_VARIABLE err)
+if(NOT status EQUAL 2 OR NOT err MATCHES "--use-default-speed needs --default-feed MM_PER_MIN")
+  message(FATAL_ERROR "--use-default-speed without --default-feed: exit ${status}, stderr ${err}")
+endif()

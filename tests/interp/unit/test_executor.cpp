@@ -244,6 +244,97 @@ TEST_F(ExecTest, TwoAxisUsersInOneBlockIsAnError) {
     EXPECT_EQ(error_of("G92 G51 X10 P2"), "test.nc:7:5: G92 and G51 both use the axis words");
 }
 
+// The messages of the setting-write, I/O and motion steps, each with the column of the word it
+// names (a block's own column is 1). Every expected text was written from the rule it enforces.
+TEST_F(ExecTest, ErrorMessagesOfSettingWrites) {
+    EXPECT_EQ(error_of("G92"), "test.nc:7:1: G92 needs at least one axis word");
+    EXPECT_EQ(error_of("G921"), "test.nc:7:1: G921 needs at least one axis word");
+    EXPECT_EQ(error_of("G922 P0"), "test.nc:7:1: G922 needs at least one axis word");
+    EXPECT_EQ(error_of("G923 P1"), "test.nc:7:1: G923 needs at least one of X Y Z");
+    EXPECT_EQ(error_of("G992"), "test.nc:7:1: G992 needs X Y Z or I J K");
+    EXPECT_EQ(error_of("G992 X1 I1"), "test.nc:7:1: G992: use either X Y Z or I J K, not both");
+    EXPECT_EQ(error_of("G68 X0 Y0"), "test.nc:7:1: G68 needs R<angle in degrees>");
+    EXPECT_EQ(error_of("G01 X1 F-5"), "test.nc:7:8: negative feed rate F-5");
+    BackendConfig v54;
+    v54.v54_compat = true;
+    v54.t_changes_tool = false;
+    make(v54);
+    EXPECT_EQ(error_of("G992 I1"), "test.nc:7:1: G992 I J K is not available in NcStudio V5.4");
+    EXPECT_EQ(error_of("M06"), "test.nc:7:1: M06 without a selected tool (T)");
+}
+
+TEST_F(ExecTest, ErrorMessagesOfMotionWords) {
+    EXPECT_EQ(error_of("G53"), "test.nc:7:1: G53 needs axis words");
+    EXPECT_EQ(error_of("G53 G02 X1 R1"), "test.nc:7:1: G53 works only with G00 or G01");
+    EXPECT_EQ(error_of("G02 X1 R1 I1 F60"), "test.nc:7:8: arc has both R and I/J/K");
+    run({"G64 P0.1 G01 X0 F60"});  // G64 P alone is fine
+    run({"G81 X1 Y1 Z-1 R1"});
+    EXPECT_EQ(error_of("G64 P0.1 X2"), "test.nc:7:5: G64 in a canned-cycle block: P is ambiguous");
+}
+
+TEST_F(ExecTest, ErrorMessagesOfTransforms) {
+    // A 30° rotation in ZX tips the XY plane out of every machine plane.
+    run({"G18 G68 X0 Z0 R30", "G17 G01 F60"});
+    EXPECT_EQ(error_of("G02 X1 Y1 R1"),
+              "test.nc:7:1: arc plane is not a machine plane after the programmed rotation");
+    make();
+    for (std::size_t i = 0; i < ProgramTransform::kMaxEntries; ++i) run({"G68 X0 Y0 R1"});
+    EXPECT_EQ(error_of("G68 X0 Y0 R1"), "test.nc:7:1: G68: too many nested transforms (at most 32)");
+}
+
+TEST_F(ExecTest, ErrorMessagesOfMachineCodes) {
+    Block msg = blk("G01 X1 F60", 7);
+    msg.msg = "hello";
+    EXPECT_THROW(
+        {
+            try {
+                exec->execute(msg);
+            } catch (const Error& e) {
+                EXPECT_STREQ(e.what(), "test.nc:7:1: MSG is only allowed with M801");
+                throw;
+            }
+        },
+        Error);
+    EXPECT_EQ(error_of("M802 P1.5"), "test.nc:7:6: M802: P must be an integer");
+    EXPECT_EQ(error_of("M902"), "test.nc:7:1: M902 needs H<axis> (0=X 1=Y 2=Z 3=A)");
+    auto kw_error = [&](Block b) {
+        try {
+            exec->execute(b);
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    Block m901 = blk("M901", 7);
+    m901.kw.plc = 4;
+    EXPECT_EQ(kw_error(m901), "test.nc:7:1: M901 PLC[...] needs LEVEL0 or LEVEL1");
+    m901.kw.level = 2;
+    EXPECT_EQ(kw_error(m901), "test.nc:7:1: M901: LEVEL must be 0 or 1");
+    Block g906 = blk("G906 P100", 7);
+    g906.kw.plc = 4;
+    g906.kw.level = 2;
+    EXPECT_EQ(kw_error(g906), "test.nc:7:1: G906: LEVEL must be 0 or 1");
+    g906 = blk("G906 P-1", 7);
+    g906.kw.plc = 4;
+    g906.kw.level = 1;
+    EXPECT_EQ(kw_error(g906), "test.nc:7:6: G906: negative timeout");
+    Block g916 = blk("G916", 7);
+    g916.kw.p_axis[0] = 0;
+    EXPECT_EQ(kw_error(g916), "test.nc:7:1: G916: axis X needs PX[addr] and LX");
+    g916.kw.l_axis[0] = 3;
+    EXPECT_EQ(kw_error(g916), "test.nc:7:1: G916: LX must be 0 or 1");
+    Block g904 = blk("G904 Z-5", 7);
+    EXPECT_EQ(kw_error(g904), "test.nc:7:6: G904: Z travel without FZ PZ LZ");
+    g904 = blk("G904", 7);
+    g904.kw.f_axis[2] = 0;
+    g904.kw.p_axis[2] = 12;
+    g904.kw.l_axis[2] = 1;
+    EXPECT_EQ(kw_error(g904), "test.nc:7:1: G904: axis Z has speed 0");
+    g904.kw.f_axis[2] = -60;
+    g904.kw.l_axis[2] = 2;
+    EXPECT_EQ(kw_error(g904), "test.nc:7:1: G904: LZ must be 0 or 1");
+}
+
 // S0's own CRC example starts with `G92 G0 X0 Y0`: the axis words belong to G92 and G00 only
 // becomes the modal motion.
 TEST_F(ExecTest, MotionCodeWithG92OnlySetsTheMode) {
