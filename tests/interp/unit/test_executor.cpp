@@ -279,7 +279,8 @@ TEST_F(ExecTest, ErrorMessagesOfTransforms) {
               "test.nc:7:1: arc plane is not a machine plane after the programmed rotation");
     make();
     for (std::size_t i = 0; i < ProgramTransform::kMaxEntries; ++i) run({"G68 X0 Y0 R1"});
-    EXPECT_EQ(error_of("G68 X0 Y0 R1"), "test.nc:7:1: G68: too many nested transforms (at most 32)");
+    EXPECT_EQ(error_of("G68 X0 Y0 R1"),
+              "test.nc:7:1: G68: too many nested transforms (at most 32)");
 }
 
 TEST_F(ExecTest, ErrorMessagesOfMachineCodes) {
