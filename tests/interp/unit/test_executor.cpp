@@ -106,6 +106,25 @@ TEST_F(ExecTest, G00_4_DefaultSpeedReplacesProgrammedF) {
     EXPECT_DOUBLE_EQ(exec->state().feed.programmed.feed_mm_s, 10.0);
 }
 
+// G00-4 with canned cycles: the cycle's feed moves run at the default too, and a G905 cycle
+// block at its own F (300 mm/min = 5 mm/s); every move of that block carries the flag.
+TEST_F(ExecTest, G00_4_CannedCyclesRunAtTheDefaultFeed) {
+    BackendConfig cfg;
+    cfg.use_default_speed = true;
+    cfg.default_feed_mm_s = 20;
+    make(cfg);
+    run({"G00 Z10"});
+    EXPECT_EQ(run({"G81 X1 Y1 Z-5 R2 F300"}),
+              (V{"feed-rate 20mm/s", "traverse X1 Y1 Z10", "traverse X1 Y1 Z2", "feed X1 Y1 Z-5",
+                 "traverse X1 Y1 Z10"}));
+    EXPECT_EQ(run({"G905 X2"}),
+              (V{"feed-rate 5mm/s", "traverse X2 Y1 Z10 programmed-feed",
+                 "traverse X2 Y1 Z2 programmed-feed", "feed X2 Y1 Z-5 programmed-feed",
+                 "traverse X2 Y1 Z10 programmed-feed"}));
+    EXPECT_EQ(run({"X3"}), (V{"feed-rate 20mm/s", "traverse X3 Y1 Z10", "traverse X3 Y1 Z2",
+                              "feed X3 Y1 Z-5", "traverse X3 Y1 Z10"}));
+}
+
 TEST_F(ExecTest, G00_4_DefaultSpeedErrors) {
     BackendConfig cfg;
     cfg.use_default_speed = true;
