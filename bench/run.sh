@@ -88,7 +88,8 @@ fi
 
 # A program that fails on one side gets "failed" in that side's cells, its reason on stderr, and
 # the script exits 1 after printing the table.
-declare -A segments bound ours ratio seg_per_s ours_jerk run_motion speedup lcnc lcnc_note
+declare -A segments bound ours ratio seg_per_s ours_jerk run_motion speedup lcnc lcnc_note accel_bound
+declare -A lcnc_dev
 failures=0
 fail_note() {
     echo "$0: $1 failed on $(rel "$2"):" >&2
@@ -97,7 +98,8 @@ fail_note() {
 }
 
 # Our planner alone: bench_motion plans each program through the real interpreter and samples
-# it at the servo period (CSV: program,jerk_mm_s3,segments,bound_s,motion_s,ratio,plan_seg_per_s).
+# it at the servo period (CSV: program,jerk_mm_s3,segments,bound_s,motion_s,ratio,plan_seg_per_s,
+# accel_bound_s,accel_ratio; accel_bound_s is the acceleration-aware lower bound).
 # (--jerk before --csv: a --jerk value list would swallow the program names that follow it.)
 jerks=(--jerk 0)
 [[ $jerk_mm_s3 == 0 ]] || jerks+=(--jerk "$jerk_mm_s3")
@@ -107,11 +109,12 @@ for prog in "${programs[@]}"; do
         ours[$prog]=failed
         continue
     fi
-    while IFS=, read -r _ jerk segs b m r rate; do
+    while IFS=, read -r _ jerk segs b m r rate lb _; do
         if [[ $jerk != 0 ]]; then
             ours_jerk[$prog]=$m
         else
             segments[$prog]=$segs bound[$prog]=$b ours[$prog]=$m ratio[$prog]=$r seg_per_s[$prog]=$rate
+            accel_bound[$prog]=$lb
         fi
     done < <(printf '%s\n' "$csv" | grep -v '^program,')
 done
@@ -139,12 +142,21 @@ if [[ $use_linuxcnc -eq 1 ]]; then
         times=()
         for ((rep = 0; rep < linuxcnc_reps; ++rep)); do
             echo "LinuxCNC: $(rel "$prog") run $((rep + 1))/$linuxcnc_reps ..." >&2
-            if ! result=$("$bench_dir"/linuxcnc/run.sh "$prog" 2>&1); then
+            # Its commanded X Y Z every cycle, checked against the path and the limits below.
+            trace=$(mktemp /tmp/lcnctrace.XXXXXX)
+            if ! result=$("$bench_dir"/linuxcnc/run.sh --trace "$trace" "$prog" 2>&1); then
+                rm -f "$trace"
                 fail_note LinuxCNC "$prog" "$result"
                 lcnc[$prog]=failed
                 continue 2
             fi
             times+=("$(printf '%s\n' "$result" | sed -n 's/^motion_s=//p')")
+            # Largest distance from the programmed path (the worst of the runs).
+            if check=$("$bench_motion" --trace-check "$trace" "$prog" 2>&1); then
+                dev=$(printf '%s\n' "$check" | sed -n 's/^  max distance from the path \([0-9.]*\) mm.*/\1/p')
+                lcnc_dev[$prog]=$(printf '%s\n%s\n' "${lcnc_dev[$prog]:-0}" "$dev" | sort -g | tail -n 1)
+            fi
+            rm -f "$trace"
             runs=$(printf '%s\n' "$result" | sed -n 's/^runs=//p')
             [[ $runs == 1 ]] || lcnc_note[$prog]=" (stopped $((runs - 1))x mid-program)"
         done
@@ -158,8 +170,8 @@ fi
 
 jerk_head="ours, jerk $jerk_mm_s3 s"
 [[ $jerk_mm_s3 == 0 ]] && jerk_head="ours, jerk-limited s"
-echo "| program | segments | bound s | ours s | ours/bound | cnc run s | LinuxCNC s | ours/LinuxCNC | plan seg/s | sim-clock x real time | $jerk_head |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| program | segments | bound s | accel bound s | ours s | ours/bound | ours/accel bound | cnc run s | LinuxCNC s | LinuxCNC max deviation mm | ours/LinuxCNC | plan seg/s | sim-clock x real time | $jerk_head |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 num() { [[ $2 =~ ^[0-9.e+-]+$ ]] && printf "$1" "$2" || printf '%s' "${2:--}"; }
 for prog in "${programs[@]}"; do
     o=${ours[$prog]}
@@ -168,10 +180,15 @@ for prog in "${programs[@]}"; do
     [[ $l =~ ^[0-9.]+$ && $o =~ ^[0-9.]+$ ]] && vs=$(awk -v a="$o" -v b="$l" 'BEGIN { printf "%.3f", a / b }')
     j=${ours_jerk[$prog]:-}
     [[ -n $j ]] && j=$(awk -v a="$j" -v b="$o" 'BEGIN { printf "%.3f (%+.3f)", a, a - b }')
-    printf '| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n' \
+    lb=${accel_bound[$prog]:-}
+    vs_lb=-
+    [[ $lb =~ ^[0-9.]+$ && $o =~ ^[0-9.]+$ ]] && vs_lb=$(awk -v a="$o" -v b="$lb" 'BEGIN { printf "%.4f", a / b }')
+    printf '| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |\n' \
         "$(basename "$prog")" "${segments[$prog]:--}" "$(num %.3f "${bound[$prog]:-}")" \
-        "$(num %.3f "$o")" "$(num %.4f "${ratio[$prog]:-}")" "${run_motion[$prog]:--}" \
-        "${l:--}${lcnc_note[$prog]:-}" "$vs" "$(num %.3g "${seg_per_s[$prog]:-}")" \
+        "$(num %.3f "$lb")" "$(num %.3f "$o")" "$(num %.4f "${ratio[$prog]:-}")" "$vs_lb" \
+        "${run_motion[$prog]:--}" \
+        "${l:--}${lcnc_note[$prog]:-}" "${lcnc_dev[$prog]:--}" "$vs" \
+        "$(num %.3g "${seg_per_s[$prog]:-}")" \
         "${speedup[$prog]:--}" "${j:--}"
 done
 [[ $failures -eq 0 ]] || { echo "$0: $failures failed run(s), see above" >&2; exit 1; }

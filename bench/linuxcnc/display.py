@@ -9,6 +9,9 @@ LCNC_BENCH_PROGRAM; the result goes to LCNC_BENCH_OUT as key=value lines:
   runs      how many separate motions that time was made of (1 = no stop mid-program)
   wall_s    wall-clock seconds from AUTO_RUN until the program is idle and in position
   error     LinuxCNC's first error message, if any (the run then counts as failed)
+  trace_samples, trace_overruns  with LCNC_BENCH_TRACE set (run.sh --trace): how many servo
+            cycles halsampler copied to that file (X Y Z per line, trace.hal) and how many the
+            sampler FIFO dropped (must be 0 for a usable trace)
 
 Needs Debian's /usr/bin/python3 (the linuxcnc module is built for it).
 """
@@ -72,9 +75,13 @@ class Bench:
         self.cmd.wait_complete()
         self.wait_for("auto mode", lambda s: s.task_mode == linuxcnc.MODE_AUTO)
 
-    def run(self, program):
+    def run(self, program, trace_path=None):
         self.cmd.program_open(program)
         self.cmd.wait_complete()
+        tracer = None
+        if trace_path:
+            # halsampler drains the FIFO while the program runs; it only fills while moving.
+            tracer = subprocess.Popen(["halsampler", "-c", "0", trace_path])
         halcmd("sets", "bench-reset", "FALSE")
         start = time.monotonic()
         self.cmd.auto(linuxcnc.AUTO_RUN, 0)
@@ -91,11 +98,30 @@ class Bench:
         motion_s = halcmd("getp", "bench-time.out")
         if float(motion_s) <= 0:
             raise RuntimeError("the program ended without a counted motion")
-        return {
+        result = {
             "motion_s": motion_s,
             "runs": halcmd("getp", "bench-runs.count"),
             "wall_s": f"{wall_s:.4f}",
         }
+        if tracer:
+            result.update(self.stop_trace(tracer, trace_path))
+        return result
+
+    @staticmethod
+    def stop_trace(tracer, trace_path):
+        # The FIFO is empty once halsampler has written one line per sampled cycle.
+        expected = int(halcmd("getp", "sampler.0.curr-depth") or 0)
+        deadline = time.monotonic() + STEP_TIMEOUT_S
+        while expected > 0 and time.monotonic() < deadline:
+            time.sleep(0.05)
+            expected = int(halcmd("getp", "sampler.0.curr-depth"))
+        time.sleep(0.2)
+        tracer.terminate()
+        tracer.wait()
+        with open(trace_path) as f:
+            samples = sum(1 for _ in f)
+        return {"trace_samples": samples,
+                "trace_overruns": halcmd("getp", "sampler.0.overruns")}
 
 
 def main():
@@ -104,7 +130,7 @@ def main():
     bench = Bench()
     try:
         bench.machine_on_homed_auto()
-        result = bench.run(program)
+        result = bench.run(program, os.environ.get("LCNC_BENCH_TRACE"))
     except Exception as exc:  # any failure is reported to run.sh, which exits non-zero
         result = {"error": str(exc)}
     with open(out_path, "w") as out:

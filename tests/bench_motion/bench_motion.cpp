@@ -12,9 +12,11 @@
 #include <string>
 #include <vector>
 
+#include "accel_bound.hpp"
 #include "motion/planner.hpp"
 #include "motion/sampler.hpp"
 #include "ngc_program.hpp"
+#include "trace_check.hpp"
 
 namespace {
 
@@ -25,6 +27,13 @@ struct Settings {
     double reserve = PlannerConfig{}.override_reserve;
     double junction_share = PlannerConfig{}.junction_share;
 };
+
+AxisLimits limits_for(const Settings& s) {
+    AxisLimits lim;
+    lim.vel_mm_s.fill(s.vel_mm_s);
+    lim.acc_mm_s2.fill(s.acc_mm_s2);
+    return lim;
+}
 
 PlannerConfig config_for(const Settings& s, double jerk) {
     PlannerConfig cfg;
@@ -69,7 +78,9 @@ struct RunResult {
 };
 
 // Plays the plan through the realtime sampler at the servo period, as the servo thread would.
-RunResult run(const PlannerConfig& cfg, const bench::BenchProgram& prog) {
+// trace_out: if open, one "X Y Z" line per period (the format of bench/linuxcnc/trace.hal).
+RunResult run(const PlannerConfig& cfg, const bench::BenchProgram& prog,
+              std::FILE* trace_out = nullptr) {
     RunResult res;
     std::vector<PreparedSegment> recs = plan_all(cfg, prog);
     for (const auto& r : recs) res.planned_s += r.profile.duration_s;
@@ -81,6 +92,8 @@ RunResult run(const PlannerConfig& cfg, const bench::BenchProgram& prog) {
     do {
         ms = sampler.advance(cfg.servo_period_s);
         ++periods;
+        if (trace_out)
+            std::fprintf(trace_out, "%f %f %f\n", ms.pos_mm[0], ms.pos_mm[1], ms.pos_mm[2]);
         for (int k = 0; k < kAxes; ++k) {
             res.max_vel[k] = std::max(res.max_vel[k], std::fabs(ms.vel_mm_s[k]));
             res.max_acc[k] = std::max(res.max_acc[k], std::fabs(ms.acc_mm_s2[k]));
@@ -149,6 +162,7 @@ struct Row {
     std::size_t segments = 0;
     double bound_s = 0;
     RunResult run;
+    double accel_bound_s = 0;
     double seg_per_s = 0;
 };
 
@@ -157,8 +171,9 @@ void print_row_text(const Row& r, double base_s) {
     double motion_s = r.run.sampled_s;
     fmt::print(
         "{} {}: {} segments, motion time {:.3f} s (planned {:.4f} s), bound {:.3f} s, "
-        "ratio {:.4f}",
-        r.program, label, r.segments, motion_s, r.run.planned_s, r.bound_s, motion_s / r.bound_s);
+        "ratio {:.4f}, acceleration-aware bound {:.3f} s, ratio {:.4f}",
+        r.program, label, r.segments, motion_s, r.run.planned_s, r.bound_s, motion_s / r.bound_s,
+        r.accel_bound_s, motion_s / r.accel_bound_s);
     if (r.jerk > 0 && base_s > 0) fmt::print(", extra {:+.3f} s vs unlimited", motion_s - base_s);
     fmt::print(
         "\n  max |v| xyz {:.2f} {:.2f} {:.2f} mm/s, max |a| xyz {:.1f} {:.1f} {:.1f} mm/s^2, "
@@ -170,8 +185,9 @@ void print_row_text(const Row& r, double base_s) {
 }
 
 void print_row_csv(const Row& r) {
-    fmt::print("{},{:g},{},{:.4f},{:.4f},{:.4f},{:.0f}\n", r.program, r.jerk, r.segments, r.bound_s,
-               r.run.sampled_s, r.run.sampled_s / r.bound_s, r.seg_per_s);
+    fmt::print("{},{:g},{},{:.4f},{:.4f},{:.4f},{:.0f},{:.4f},{:.4f}\n", r.program, r.jerk,
+               r.segments, r.bound_s, r.run.sampled_s, r.run.sampled_s / r.bound_s, r.seg_per_s,
+               r.accel_bound_s, r.run.sampled_s / r.accel_bound_s);
 }
 
 // The smoke run must at least end where the program ends, within the limits.
@@ -181,6 +197,41 @@ bool within_limits(const Settings& s, const RunResult& r) {
         ok = ok && r.max_vel[k] <= s.vel_mm_s * (1 + 1e-9) &&
              r.max_acc[k] <= s.acc_mm_s2 * (1 + 1e-9);
     return ok;
+}
+
+int print_trace_check(const Settings& s, const std::string& program, const std::string& path,
+                      double quantum_mm) {
+    bench::BenchProgram prog = bench::read_program(program, s.tolerance_mm);
+    bench::TraceReport r =
+        bench::check_trace(prog, bench::read_trace(path), s.period_s, quantum_mm);
+    double lb = bench::accel_lower_bound(prog, limits_for(s)).time_s;
+    fmt::print("{} against {}:\n", path, program);
+    fmt::print("  {} samples = {:.3f} s (bound {:.3f} s, acceleration-aware bound {:.3f} s)\n",
+               r.samples, r.samples * s.period_s, bound_s(s, prog), lb);
+    fmt::print("  max distance from the path {:.4f} mm near line {} (tolerance there {} mm); "
+               "{} samples beyond their tolerance + {:g} mm\n",
+               r.max_deviation_mm, r.deviation_line, r.deviation_tolerance_mm,
+               r.samples_over_tolerance, quantum_mm);
+    fmt::print("  on feed moves: max {:.4f} mm, {} samples beyond; on rapids: max {:.4f} mm, {} "
+               "samples beyond\n",
+               r.max_deviation_feed_mm, r.over_tolerance_feed, r.max_deviation_rapid_mm,
+               r.over_tolerance_rapid);
+    std::vector<std::pair<double, int>> worst;
+    for (const auto& [line, d] : r.over_by_line) worst.emplace_back(d, line);
+    std::sort(worst.rbegin(), worst.rend());
+    if (!worst.empty()) fmt::print("  lines beyond the tolerance (worst first):");
+    for (std::size_t i = 0; i < worst.size() && i < 8; ++i)
+        fmt::print(" {} ({:.4f} mm)", worst[i].second, worst[i].first);
+    if (worst.size() > 8) fmt::print(" and {} more", worst.size() - 8);
+    if (!worst.empty()) fmt::print("\n");
+    fmt::print("  max |v| xyz {:.2f} {:.2f} {:.2f} mm/s, max |a| xyz {:.1f} {:.1f} {:.1f} mm/s^2 "
+               "(finite differences; +-{:.1f} mm/s^2 from the {:g} mm resolution)\n",
+               r.max_vel_mm_s[0], r.max_vel_mm_s[1], r.max_vel_mm_s[2], r.max_acc_mm_s2[0],
+               r.max_acc_mm_s2[1], r.max_acc_mm_s2[2], 4 * quantum_mm / (s.period_s * s.period_s),
+               quantum_mm);
+    fmt::print("  max path speed / feed {:.4f}, end error {:.2e} mm\n", r.max_speed_over_feed,
+               r.end_error_mm);
+    return 0;
 }
 
 }  // namespace
@@ -203,7 +254,8 @@ int main(int argc, char** argv) {
         ->delimiter(',');
     app.add_flag("--csv", csv,
                  "one row per (program, jerk): "
-                 "program,jerk_mm_s3,segments,bound_s,motion_s,ratio,plan_seg_per_s");
+                 "program,jerk_mm_s3,segments,bound_s,motion_s,ratio,plan_seg_per_s,accel_bound_s,"
+                 "accel_ratio");
     app.add_option("--vel", s.vel_mm_s, "per-axis velocity limit, mm/s");
     app.add_option("--acc", s.acc_mm_s2, "per-axis acceleration limit, mm/s^2");
     app.add_option("--reserve", s.reserve, "share of acc/jerk kept for override and hold");
@@ -214,13 +266,27 @@ int main(int argc, char** argv) {
     app.add_option("--excess", excess, "list the N lines with the most time over their bound");
     app.add_option("--min-cpu", min_cpu_s, "CPU seconds to spend measuring each throughput");
     app.add_flag("--smoke", smoke, "one quick pass (jerk unlimited, no throughput), for ctest");
+    std::string trace_out, trace_check;
+    double trace_quantum_mm = 1e-6;
+    app.add_option("--trace-out", trace_out,
+                   "write our commanded X Y Z per servo period to this file (first program and "
+                   "jerk)");
+    app.add_option("--trace-check", trace_check,
+                   "check a recorded trace (X Y Z per servo period, bench/linuxcnc/run.sh "
+                   "--trace) against the first program's path and the limits, then exit");
+    app.add_option("--trace-quantum", trace_quantum_mm,
+                   "resolution of the trace's numbers, mm (halsampler prints 6 decimals)");
     CLI11_PARSE(app, argc, argv);
     if (programs.empty()) programs.push_back(MOTION_BENCH_DEFAULT_PROGRAM);
     if (jerks.empty() || smoke) jerks = {0};
 
     try {
+        if (!trace_check.empty())
+            return print_trace_check(s, programs.front(), trace_check, trace_quantum_mm);
         if (csv)
-            fmt::print("program,jerk_mm_s3,segments,bound_s,motion_s,ratio,plan_seg_per_s\n");
+            fmt::print(
+                "program,jerk_mm_s3,segments,bound_s,motion_s,ratio,plan_seg_per_s,accel_bound_s,"
+                "accel_ratio\n");
         else
             fmt::print(
                 "settings: {} mm/s, {} mm/s^2 per axis, servo {} Hz, default G64 P{}, "
@@ -233,7 +299,15 @@ int main(int argc, char** argv) {
             double base_s = 0;
             for (double j : jerks) {
                 PlannerConfig cfg = config_for(s, j);
-                Row row{program, j, prog.segments.size(), bound_s(s, prog), run(cfg, prog), 0};
+                std::FILE* trace = nullptr;
+                if (!trace_out.empty() && program == programs.front() && j == jerks.front()) {
+                    trace = std::fopen(trace_out.c_str(), "w");
+                    if (!trace) throw std::runtime_error(trace_out + ": cannot write the trace");
+                }
+                Row row{program, j, prog.segments.size(), bound_s(s, prog), run(cfg, prog, trace),
+                        0};
+                if (trace) std::fclose(trace);
+                row.accel_bound_s = bench::accel_lower_bound(prog, limits_for(s)).time_s;
                 if (!smoke) row.seg_per_s = throughput_seg_s(cfg, prog, min_cpu_s);
                 if (j == 0) base_s = row.run.sampled_s;
                 if (csv)
@@ -241,6 +315,13 @@ int main(int argc, char** argv) {
                 else
                     print_row_text(row, base_s);
                 if (excess > 0 && !csv) print_excess(s, cfg, prog, excess);
+                // Our run keeps the limits and the tolerance, so it cannot beat a lower bound.
+                if (smoke && row.run.sampled_s < row.accel_bound_s - 1e-9) {
+                    std::fprintf(stderr, "bench_motion: motion time %.4f s is below the "
+                                 "acceleration-aware lower bound %.4f s\n",
+                                 row.run.sampled_s, row.accel_bound_s);
+                    return 1;
+                }
                 if (smoke && !within_limits(s, row.run)) {
                     std::fprintf(stderr,
                                  "bench_motion: smoke run left the limits or the path end\n");
