@@ -67,18 +67,26 @@ void validate(const PlannerConfig& cfg) {
                                         ": jerk limit must be >= 0 (0 = unlimited)");
     }
     if (!(cfg.servo_period_s > 0)) throw std::invalid_argument("servo period must be > 0");
-    if (!(cfg.override_reserve > 0 && cfg.junction_share >= 0 &&
-          cfg.override_reserve + cfg.junction_share < 1))
-        throw std::invalid_argument(
-            "override_reserve must be > 0 and override_reserve + junction_share < 1");
+    for (double reserve : {cfg.override_reserve, cfg.override_reserve_no_jerk})
+        if (!(reserve > 0 && cfg.junction_share >= 0 && reserve + cfg.junction_share < 1))
+            throw std::invalid_argument(
+                "override_reserve and override_reserve_no_jerk must be > 0 and each plus "
+                "junction_share < 1");
     if (!(cfg.max_rate >= 1)) throw std::invalid_argument("max_rate must be >= 1");
     if (cfg.window < 2) throw std::invalid_argument("window must hold at least 2 elements");
+}
+
+double override_reserve_in_effect(const PlannerConfig& cfg) noexcept {
+    bool jerk = std::any_of(cfg.limits.jerk_mm_s3.begin(), cfg.limits.jerk_mm_s3.end(),
+                            [](double j) { return j > 0; });
+    return jerk ? cfg.override_reserve : cfg.override_reserve_no_jerk;
 }
 
 Planner::Planner(const PlannerConfig& cfg, const AxisArray& start) : cfg_(cfg), last_end_(start) {
     validate(cfg_);
     jerk_mode_ = std::any_of(cfg_.limits.jerk_mm_s3.begin(), cfg_.limits.jerk_mm_s3.end(),
                              [](double j) { return j > 0; });
+    reserve_ = override_reserve_in_effect(cfg_);
     items_.reserve(cfg_.window * 2);
     vj_.reserve(cfg_.window * 2 + 1);
     out_.reserve(cfg_.window * 2);
@@ -165,14 +173,29 @@ Planner::Junction Planner::classify(const Piece& p, const Piece& next) const {
     // A kink that is not blended: pass it only as fast as a velocity step of junction_share of
     // one servo period's acceleration (and jerk) allows. For real corners that speed is next
     // to nothing, and stopping outright spares both neighbours the junction share.
+    // Several kinks can fall in one period when the moves between them are shorter than a
+    // period's travel W = v max_rate period; their steps add up. A kink with a neighbour that
+    // short (L: half the shorter neighbour, as blends at the far ends may trim them) takes
+    // 1 / (2 + 2 W / L) of the share: in any window of length W the first such kink takes at
+    // most 1/2 and each further one at most L / 2W, and the moves between them, each at least
+    // its kinks' L long, fit in W, so the steps in one period add up to at most the share. A
+    // kink whose neighbours are both longer than W shares its period with no other kink.
     double share = cfg_.junction_share, period = cfg_.servo_period_s;
+    double near_mm = std::min(p.geom.length_mm, next.geom.length_mm) / 2;
+    double travel_per_v = cfg_.max_rate * period;  // W / v
     double cap = kInf;
     for (int k = 0; k < kAxes; ++k) {
-        if (std::fabs(dt[k]) <= kTangentEps) continue;
+        double d = std::fabs(dt[k]);
+        if (d <= kTangentEps) continue;
         double step = share * lim.acc_mm_s2[k] * period;
         if (lim.jerk_mm_s3[k] > 0)
             step = std::min(step, share * lim.jerk_mm_s3[k] * period * period);
-        cap = std::min(cap, step / std::fabs(dt[k]));
+        double v = step / d;
+        if (v * travel_per_v > near_mm) {  // 2 d v + 2 d (v travel_per_v / near) v = step
+            double qa = 2 * d * travel_per_v / near_mm, qb = 2 * d;
+            v = std::min(v, (-qb + std::sqrt(qb * qb + 4 * qa * step)) / (2 * qa));
+        }
+        cap = std::min(cap, v);
     }
     // Kinks with an arc (rounding in the program, or a real corner): a blend where passing
     // the kink would cost speed.
@@ -285,7 +308,7 @@ void Planner::add_item(const Element& e, double feed, double end_cap, bool rough
                        std::int32_t line) {
     Item it;
     it.geom = e;
-    double cut = cfg_.override_reserve + (rough ? cfg_.junction_share : 0);
+    double cut = reserve_ + (rough ? cfg_.junction_share : 0);
     it.lim = element_limits(e, bounds(e), cfg_.limits, feed, {1 - cut, 1 - cut});
     it.end_cap_mm_s = end_cap;
     it.rough = rough;
@@ -478,7 +501,7 @@ void Planner::emit(const Item& it, const Profile1D& prof) {
     PreparedSegment& rec = out_.emplace_back();
     rec.geom = it.geom;
     rec.profile = prof;
-    LimitShares rate_share{1 - cfg_.override_reserve, 1 - cfg_.override_reserve};
+    LimitShares rate_share{1 - reserve_, 1 - reserve_};
     ElementBounds b = bounds(it.geom);
     for (int i = 0; i < prof.count; ++i) {
         // Peaks of a cubic phase are at its ends (|v| and |a| are monotone within a phase).

@@ -10,6 +10,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Single block: braking for a block's end starts when the deceleration that lands on it reaches
 // this share of the limit, leaving room for the speed the next period could still add.
 constexpr double kBlockBrakeShare = 0.8;
+// Without a jerk limit r'' is free; r' still ramps over this time so the rate stays smooth.
+constexpr double kRateRampS = 0.005;
 
 bool is_action(const PreparedSegment& rec) noexcept {
     return rec.action.kind != ActionKind::None;
@@ -48,8 +50,9 @@ MotionSample sample(const PreparedSegment& seg, double t) noexcept {
 SamplerConfig sampler_config(const PlannerConfig& p) {
     SamplerConfig s;
     s.limits = p.limits;
-    s.override_reserve = p.override_reserve;
+    s.override_reserve = override_reserve_in_effect(p);
     s.max_rate = p.max_rate;
+    s.junction_share = p.junction_share;
     return s;
 }
 
@@ -67,7 +70,7 @@ RateLimits rate_limits(const SamplerConfig& cfg) noexcept {
         }
     }
     // Without a jerk limit r'' is free; a 5 ms ramp of r' keeps the rate smooth anyway.
-    if (!std::isfinite(am)) am = vm / 0.005;
+    if (!std::isfinite(am)) am = vm / kRateRampS;
     return {vm, am};
 }
 
@@ -133,9 +136,9 @@ void Sampler::action_done() noexcept {
     if (status_.action_pending) action_done_ = true;
 }
 
-double Sampler::rate_target() const noexcept {
+double Sampler::rate_target(double dt) const noexcept {
     if (abort_ || hold_) return 0;
-    return std::min(current_override(), rate_cap_ahead());
+    return std::min(current_override(), jerk_limited_ ? rate_cap_ahead() : rate_cap_free(dt));
 }
 
 double Sampler::rate_cap_ahead() const noexcept {
@@ -227,7 +230,11 @@ RateLimits Sampler::rate_limits_now(double target, double dt) const noexcept {
     for (int k = 0; k < kAxes; ++k) {
         double vk = std::fabs(now.vel_mm_s[k]) + lim.acc_mm_s2[k] * r_ * horizon;
         if (vk <= 0) continue;
-        vm = std::min(vm, lim.acc_mm_s2[k] * (1 - keep * r_ * r_) / vk);
+        // Next to an unblended kink the plan uses keep - junction_share and the kink's velocity
+        // step (junction_share of a period's acceleration) scales with r, not r^2.
+        const double js = cfg_.junction_share;
+        const double used = std::max(keep * r_ * r_, (keep - js) * r_ * r_ + js * r_);
+        vm = std::min(vm, lim.acc_mm_s2[k] * (1 - used) / vk);
         if (lim.jerk_mm_s3[k] > 0) {
             double free_jerk = lim.jerk_mm_s3[k] * (1 - keep * r_ * r_ * r_);
             if (r_ > 0) vm = std::min(vm, free_jerk / (2 * 3 * keep * lim.acc_mm_s2[k] * r_));
@@ -235,8 +242,149 @@ RateLimits Sampler::rate_limits_now(double target, double dt) const noexcept {
         }
     }
     if (!std::isfinite(vm)) return rl_;
-    if (!jerk_limited_) am = vm / 0.005;
+    if (!jerk_limited_) am = vm / kRateRampS;
     return {std::max(vm, rl_.max_rate_per_s), std::max(am, rl_.max_rate_per_s2)};
+}
+
+namespace {
+struct PhasePeaks {
+    double v_mm_s = 0, a_mm_s2 = 0;
+};
+
+// Largest |v| and |a| of one profile phase of duration t_s (v0 + a0 t + j t^2 / 2).
+PhasePeaks phase_peaks(const ProfilePhase& ph, double t_s) noexcept {
+    const double v0 = ph.v0_mm_s, a0 = ph.a0_mm_s2, j = ph.j_mm_s3;
+    double v = std::max(std::fabs(v0), std::fabs(v0 + a0 * t_s + j * t_s * t_s / 2));
+    if (j != 0) {
+        double t_turn = -a0 / j;
+        if (t_turn > 0 && t_turn < t_s) v = std::max(v, std::fabs(v0 - a0 * a0 / (2 * j)));
+    }
+    return {v, std::max(std::fabs(a0), std::fabs(a0 + j * t_s))};
+}
+}  // namespace
+
+// Largest |r'| for which a r^2 + v r' stays within every axis's limit on one profile phase
+// (duration t_s) of a record with derivative bounds b, at rates up to r_hi: axis k sees at most
+// a_peak g1_k + v_peak^2 g2_k and v_peak g1_k. An unblended kink steps the velocity by up to
+// junction_share of a period's acceleration (the planner's budget for it), scaled by the rate:
+// that share is kept out of the room. Infinite where nothing moves.
+double Sampler::phase_room(const ElementBounds& b, const ProfilePhase& ph, double t_s,
+                           double r_hi) const noexcept {
+    const AxisLimits& lim = cfg_.limits;
+    const double usable = 1 - cfg_.junction_share * r_hi;
+    const PhasePeaks pk = phase_peaks(ph, t_s);
+    double best = kInf;
+    for (int k = 0; k < kAxes; ++k) {
+        const double vel = pk.v_mm_s * b.g1[k];
+        if (vel <= 1e-12) continue;
+        const double acc = pk.a_mm_s2 * b.g1[k] + pk.v_mm_s * pk.v_mm_s * b.g2[k];
+        const double room = usable * lim.acc_mm_s2[k] - acc * r_hi * r_hi;
+        if (room <= 0) return 0;
+        best = std::min(best, room / vel);
+    }
+    return best;
+}
+
+// The least phase_room() over the planned time [from, to]; 0 when the ring ends before `to`
+// (nothing is known beyond it).
+double Sampler::room_rate(double from, double to, double r_hi) const noexcept {
+    const std::size_t n = std::min(ring_.size(), cfg_.lookahead_records);
+    double best = kInf, start = 0;  // start: planned time at which record i begins
+    for (std::size_t i = 0; i < n; ++i) {
+        const PreparedSegment& rec = ring_.peek(i);
+        const Profile1D& p = rec.profile;
+        if (start + p.duration_s >= from && !is_action(rec)) {
+            const ElementBounds b = bounds(rec.geom);
+            for (int ph = 0; ph < p.count; ++ph) {
+                const double t0 = p.phases[ph].t0_s;
+                const double t1 = ph + 1 < p.count ? p.phases[ph + 1].t0_s : p.duration_s;
+                if (start + t1 < from || start + t0 > to) continue;
+                best = std::min(best, phase_room(b, p.phases[ph], t1 - t0, r_hi));
+                if (best == 0) return 0;
+            }
+        }
+        start += p.duration_s;
+        if (start > to || rec.program_end) return best;
+    }
+    return 0;
+}
+
+// Without a jerk limit, the highest rate allowed now: for every phase P ahead with rate cap c_P
+// (the planner's phase_rate_cap) starting `lead` of wall time away at the highest rate, the rate
+// must be able to come down to c_P before P; on the way it can fall at least as fast as the
+// least room of the phases before P (at the highest rate) or the fixed bound, so
+// r <= c_P + down (lead - 2 dt). The rate never overshoots this target, and the target at the
+// next period is at most down dt lower, which that period's room can follow. The end of what
+// the ring holds counts as a phase with cap 1 (records beyond it are unknown).
+double Sampler::rate_cap_free(double dt) const noexcept {
+    if (std::max(override_, rapid_override_) <= 1 && r_ <= 1) return kInf;
+    const double r_max = cfg_.max_rate;
+    const double reach = r_max * ((r_max - 1) / rl_.max_rate_per_s + 2 * dt);
+    double allow = kInf, room = kInf, start = 0;
+    auto limit_at = [&](double cap, double at) {
+        const double lead = (at - tau_) / r_max - 2 * dt;
+        const double down = std::max(room, rl_.max_rate_per_s);
+        allow = std::min(allow, lead <= 0 ? cap : cap + down * lead);
+    };
+    const std::size_t n = std::min(ring_.size(), cfg_.lookahead_records);
+    for (std::size_t i = 0; i < n; ++i) {
+        const PreparedSegment& rec = ring_.peek(i);
+        const Profile1D& p = rec.profile;
+        if (start + p.duration_s >= tau_ && !is_action(rec)) {
+            const ElementBounds b = bounds(rec.geom);
+            for (int ph = 0; ph < p.count; ++ph) {
+                const double t0 = start + p.phases[ph].t0_s;
+                const double t1 = start + (ph + 1 < p.count ? p.phases[ph + 1].t0_s : p.duration_s);
+                if (t1 < tau_) continue;
+                if (t0 - tau_ > reach) return allow;
+                limit_at(rec.phase_rate_cap[ph], std::max(t0, tau_));
+                room = std::min(room, phase_room(b, p.phases[ph], t1 - t0, r_max));
+            }
+        }
+        start += p.duration_s;
+        if (rec.program_end) return allow;  // at rest at its end: nothing to scale beyond
+    }
+    limit_at(1.0, start);
+    return allow;
+}
+
+// Without a jerk limit r' may change from one period to the next (integrate_rate_free), so this
+// period's r' only has to fit the room of the stretch it covers. The fixed and the slowing-down
+// bounds (base) stay valid whatever the plan does; the larger bound is used.
+RateLimits Sampler::room_limits(const RateLimits& base, double target, double dt) const noexcept {
+    const double to = tau_ + 1e-12;
+    double vm = room_rate(tau_, to + r_ * dt, r_);  // slowing down or steady: rate stays <= r_
+    if (target > r_) {                              // speeding up: it ends at most this high
+        double r_hi = r_ + std::max(vm, base.max_rate_per_s) * dt;
+        vm = std::min(vm, room_rate(tau_, to + r_hi * dt, r_hi));
+    }
+    if (!(vm > base.max_rate_per_s)) return base;
+    return {vm, std::max(vm / kRateRampS, base.max_rate_per_s2)};
+}
+
+// Without a jerk limit: r' = +-max_rate_per_s until the rate lands exactly on the target, then 0
+// (no r' ramp, so no overshoot when the bound changes between periods); returns the planned time
+// passed.
+double Sampler::integrate_rate_free(double target, double dt, double max_rate_per_s) noexcept {
+    const double d = target - r_;
+    const double t_hit = max_rate_per_s > 0 ? std::fabs(d) / max_rate_per_s : kInf;
+    const double slope = d > 0 ? max_rate_per_s : -max_rate_per_s;
+    double passed;
+    if (d == 0) {
+        passed = r_ * dt;
+        rd_ = 0;
+    } else if (t_hit >= dt) {
+        passed = r_ * dt + slope * dt * dt / 2;
+        r_ += slope * dt;
+        rd_ = slope;
+    } else {
+        passed = r_ * t_hit + slope * t_hit * t_hit / 2 + target * (dt - t_hit);
+        r_ = target;
+        rd_ = 0;
+    }
+    rdd_ = 0;
+    if (r_ < 0) r_ = 0;
+    return std::max(passed, 0.0);
 }
 
 // At rest at the end of `cur` (the front record, finished), with a new block next.
@@ -427,7 +575,7 @@ MotionSample Sampler::advance(double dt) noexcept {
         status_.moving = false;
         return last_;
     }
-    double target = rate_target();
+    double target = rate_target(dt);
     PathState now = ring_.peek(0).profile.at(tau_);
     if (now.v_mm_s == 0 && (now.a_mm_s2 == 0 || !jerk_limited_)) {
         // At rest the rate has nothing to scale yet: take the target at once.
@@ -435,7 +583,12 @@ MotionSample Sampler::advance(double dt) noexcept {
         rd_ = rdd_ = 0;
     }
     last_limits_ = rate_limits_now(target, dt);
-    tau_ += integrate_rate(target, dt, last_limits_);
+    if (jerk_limited_) {
+        tau_ += integrate_rate(target, dt, last_limits_);
+    } else {
+        last_limits_ = room_limits(last_limits_, target, dt);
+        tau_ += integrate_rate_free(target, dt, last_limits_.max_rate_per_s);
+    }
     consume_finished_records();
     const PreparedSegment& cur = ring_.peek(0);
     MotionSample planned = sample(cur, tau_);

@@ -24,7 +24,7 @@ using namespace motion;
 
 struct Settings {
     double vel_mm_s = 100, acc_mm_s2 = 1000, period_s = 1e-3, tolerance_mm = 0.01;
-    double reserve = PlannerConfig{}.override_reserve;
+    double reserve = -1;  // < 0: the planner's defaults (PlannerConfig)
     double junction_share = PlannerConfig{}.junction_share;
 };
 
@@ -41,7 +41,7 @@ PlannerConfig config_for(const Settings& s, double jerk) {
     cfg.limits.acc_mm_s2.fill(s.acc_mm_s2);
     cfg.limits.jerk_mm_s3.fill(jerk);
     cfg.servo_period_s = s.period_s;
-    cfg.override_reserve = s.reserve;
+    if (s.reserve >= 0) cfg.override_reserve = cfg.override_reserve_no_jerk = s.reserve;
     cfg.junction_share = s.junction_share;
     return cfg;
 }
@@ -208,9 +208,9 @@ int print_trace_check(const Settings& s, const std::string& program, const std::
     fmt::print("{} against {}:\n", path, program);
     fmt::print("  {} samples = {:.3f} s (bound {:.3f} s, acceleration-aware bound {:.3f} s)\n",
                r.samples, r.samples * s.period_s, bound_s(s, prog), lb);
-    fmt::print("  max distance from the path {:.4f} mm near line {} (tolerance there {} mm); "
-               "{} samples beyond their tolerance + {:g} mm\n",
-               r.max_deviation_mm, r.deviation_line, r.deviation_tolerance_mm,
+    fmt::print("  max distance from the path {:.4f} mm near line {} (trace line {}, tolerance there "
+               "{} mm); {} samples beyond their tolerance + {:g} mm\n",
+               r.max_deviation_mm, r.deviation_line, r.deviation_sample + 1, r.deviation_tolerance_mm,
                r.samples_over_tolerance, quantum_mm);
     fmt::print("  on feed moves: max {:.4f} mm, {} samples beyond; on rapids: max {:.4f} mm, {} "
                "samples beyond\n",
@@ -258,7 +258,9 @@ int main(int argc, char** argv) {
                  "accel_ratio");
     app.add_option("--vel", s.vel_mm_s, "per-axis velocity limit, mm/s");
     app.add_option("--acc", s.acc_mm_s2, "per-axis acceleration limit, mm/s^2");
-    app.add_option("--reserve", s.reserve, "share of acc/jerk kept for override and hold");
+    app.add_option("--reserve", s.reserve,
+                   "share of acc/jerk kept for override and hold, with and without a jerk limit "
+                   "(default: the planner's, override_reserve / override_reserve_no_jerk)");
     app.add_option("--junction-share", s.junction_share,
                    "share of acc/jerk for non-smooth junctions");
     app.add_option("--tolerance", s.tolerance_mm,
@@ -290,8 +292,9 @@ int main(int argc, char** argv) {
         else
             fmt::print(
                 "settings: {} mm/s, {} mm/s^2 per axis, servo {} Hz, default G64 P{}, "
-                "reserve {}, junction share {}\n",
-                s.vel_mm_s, s.acc_mm_s2, 1 / s.period_s, s.tolerance_mm, s.reserve,
+                "reserve {} (jerk-limited) / {} (unlimited), junction share {}\n",
+                s.vel_mm_s, s.acc_mm_s2, 1 / s.period_s, s.tolerance_mm,
+                config_for(s, 1).override_reserve, config_for(s, 0).override_reserve_no_jerk,
                 s.junction_share);
         for (const std::string& program : programs) {
             bench::BenchProgram prog = bench::read_program(program, s.tolerance_mm);

@@ -15,10 +15,14 @@ namespace {
 
 using P3 = std::array<double, 3>;
 constexpr double kTwoPi = 6.28318530717958647692;
-// Moves searched around the last nearest one: behind (blends can reach back past a short move)
-// and ahead (a period at full speed crosses at most a few hundred of the shortest moves).
+// Moves searched around the last nearest one: a few behind (blends can reach back past a short
+// move) and ahead as far as the path goes within kSearchAhead_mm of the nearest move's end (a
+// period moves the tool well under 1 mm). Searching the whole path instead would match a
+// program that retraces its path (a rapid back along a cut) to the wrong pass.
 constexpr std::size_t kSearchBack = 8;
-constexpr std::size_t kSearchAhead = 400;
+constexpr double kSearchAhead_mm = 5;
+// A sample beyond the tolerance of the moves searched is checked against the whole path (the
+// smaller distance counts: it can only understate a deviation), and the search goes on there.
 
 struct Move {
     Element e;
@@ -119,11 +123,26 @@ TraceReport check_trace(const BenchProgram& prog, const std::vector<P3>& trace, 
     for (std::size_t n = 0; n < trace.size(); ++n) {
         const P3& q = trace[n];
         std::size_t lo = near > kSearchBack ? near - kSearchBack : 0;
-        std::size_t hi = std::min(moves.size(), near + kSearchAhead);
+        std::size_t hi = near + 1;
+        for (double ahead = 0; hi < moves.size() && ahead <= kSearchAhead_mm; ++hi)
+            ahead += moves[hi].e.length_mm;
         double best = INFINITY;
         for (std::size_t i = lo; i < hi; ++i) {
             double d = move_distance(moves[i], q);
             if (d < best) best = d, near = i;
+        }
+        double local_tol = std::max(moves[near].tolerance_mm,
+                                    near > 0 ? moves[near - 1].tolerance_mm : 0.0);
+        if (best > local_tol + quantum_mm) {
+            // Forward first (ties go to the later pass of a retraced path), then behind.
+            for (std::size_t i = hi; i < moves.size(); ++i) {
+                double d = move_distance(moves[i], q);
+                if (d < best) best = d, near = i;
+            }
+            for (std::size_t i = 0; i < lo; ++i) {
+                double d = move_distance(moves[i], q);
+                if (d < best) best = d, near = i;
+            }
         }
         // A corner belongs to both moves: the larger tolerance applies there.
         double tol = moves[near].tolerance_mm;
@@ -140,6 +159,7 @@ TraceReport check_trace(const BenchProgram& prog, const std::vector<P3>& trace, 
         if (best > rep.max_deviation_mm) {
             rep.max_deviation_mm = best;
             rep.deviation_line = moves[near].line;
+            rep.deviation_sample = long(n);
             rep.deviation_tolerance_mm = tol;
         }
         if (n >= 1) {

@@ -17,6 +17,7 @@ struct TraceReport {
     long samples = 0;
     double max_deviation_mm = 0;
     std::int32_t deviation_line = 0;  // source line of the move nearest the worst sample
+    long deviation_sample = 0;        // its index in the trace (0-based)
     double deviation_tolerance_mm = 0;  // the blend tolerance there (largest of the two moves)
     long samples_over_tolerance = 0;    // samples farther from the path than their tolerance
     // The same split by the kind of the nearest move: on rapids (G0) and on feed moves.

@@ -52,7 +52,7 @@ TEST(Planner, SingleLineIsATrapezoidAtTheUsableAcceleration) {
     // Along X only, the path may use (1 - reserve) of X's acceleration.
     auto recs = plan(cfg, {line_to({100}, 50)});
     ASSERT_EQ(recs.size(), 1u);
-    double a = 1000 * (1 - cfg.override_reserve);
+    double a = 1000 * (1 - override_reserve_in_effect(cfg));
     EXPECT_NEAR(total_time(recs), 100.0 / 50 + 50 / a, 1e-9);
     EXPECT_TRUE(recs.back().program_end);
 }
@@ -150,12 +150,15 @@ TEST(Planner, BlendedRightAngleIsTheParabolaWithoutJerkLimit) {
     EXPECT_NEAR(recs[1].geom.length_mm, 2 * l, 1e-12);
     EXPECT_NEAR(recs[0].geom.length_mm, 10 - l, 1e-12);
     // Constant acceleration |dT_k| / 2l v^2 per axis against the blend's centripetal share
-    // (0.95) of the usable acceleration (900): the bang-bang corner.
-    double v = std::sqrt(0.95 * 900 * 2 * l);
+    // (0.95) of the usable acceleration (1000 less the 1 % reserve kept without a jerk limit:
+    // 990): the bang-bang corner, v = sqrt(0.95 * 990 * 0.08) = 8.674 mm/s.
+    const double usable = 1000 * (1 - override_reserve_in_effect(cfg));
+    EXPECT_NEAR(usable, 990, 1e-9);
+    double v = std::sqrt(0.95 * usable * 2 * l);
     EXPECT_NEAR(recs[1].profile.peak_v_mm_s, v, 1e-9);
     MotionSample mid = sample(recs[1], recs[1].profile.duration_s / 2);
-    EXPECT_NEAR(mid.acc_mm_s2[0], -0.95 * 900, 1e-6);
-    EXPECT_NEAR(mid.acc_mm_s2[1], 0.95 * 900, 1e-6);
+    EXPECT_NEAR(mid.acc_mm_s2[0], -0.95 * usable, 1e-6);
+    EXPECT_NEAR(mid.acc_mm_s2[1], 0.95 * usable, 1e-6);
     EXPECT_NEAR(right_angle_deviation(recs[1]), tol, 1e-6);
 }
 
@@ -331,7 +334,8 @@ TEST(Planner, SmallTangentArcsFlowAtFeed) {
 
 TEST(Planner, ArcSpeedRespectsCentripetalAcceleration) {
     // Full circle of radius 5 at F200: v^2 / r within the arc's centripetal share (0.95 without
-    // a jerk limit) of the usable acceleration (900): v = sqrt(0.95 * 900 * 5) = 65.383 mm/s.
+    // a jerk limit) of the usable acceleration (990, the 1 % reserve kept without a jerk limit
+    // taken off): v = sqrt(0.95 * 990 * 5) = 68.575 mm/s.
     PlannerConfig cfg = uniform(100, 1000, 0);
     PathSegment arc;
     arc.kind = SegmentKind::Arc;
@@ -341,7 +345,7 @@ TEST(Planner, ArcSpeedRespectsCentripetalAcceleration) {
     arc.turns = 1;
     auto recs = plan(cfg, {arc}, {10, 0});
     ASSERT_EQ(recs.size(), 1u);
-    EXPECT_NEAR(recs[0].profile.peak_v_mm_s, std::sqrt(0.95 * 900 * 5), 1e-9);
+    EXPECT_NEAR(recs[0].profile.peak_v_mm_s, std::sqrt(0.95 * 990 * 5), 1e-9);
     for (int i = 0; i <= 2000; ++i) {
         MotionSample s = sample(recs[0], recs[0].profile.duration_s * i / 2000);
         EXPECT_LE(std::fabs(s.acc_mm_s2[0]), 1000 * (1 + 1e-9));

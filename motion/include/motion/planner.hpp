@@ -10,9 +10,11 @@
 //   ending at rest. Because every plan ends in a stop at the window's end, anything emitted is
 //   safe whatever arrives later; later segments can only raise the speeds still to be planned.
 //
-// Limit sharing: elements use (1 - override_reserve) of each axis's acceleration and jerk; the
-// reserve is what the sampler needs to change the time scale (override, hold, abort) without
-// exceeding the limits. Elements next to a junction that is not smooth (a tiny kink, or a
+// Limit sharing: elements use (1 - reserve) of each axis's acceleration and jerk; the reserve is
+// what the sampler needs to change the time scale (override, hold, abort) without exceeding the
+// limits whatever the plan does. Without a jerk limit the sampler also changes the rate in the
+// room each stretch of the plan leaves (sampler.hpp), so a much smaller fixed reserve is kept
+// then (override_reserve_no_jerk; override_reserve_in_effect() tells which applies). Elements next to a junction that is not smooth (a tiny kink, or a
 // curvature step under a jerk limit) also give up `junction_share`: such a junction is passed at
 // a speed where the step is at most junction_share * limit over one servo period.
 //
@@ -35,6 +37,7 @@ struct PlannerConfig {
     AxisLimits limits;
     double servo_period_s = 1e-3;
     double override_reserve = 0.1;  // share of acc/jerk kept for time scaling in the sampler
+    double override_reserve_no_jerk = 0.01;  // the same when no axis has a jerk limit
     double junction_share = 0.1;    // share of acc/jerk a non-smooth junction may take
     double max_rate = 1.2;          // highest feed override the sampler will apply
     std::size_t window = 4096;      // look-ahead length in elements
@@ -42,6 +45,10 @@ struct PlannerConfig {
 
 // Throws std::invalid_argument naming the bad field.
 void validate(const PlannerConfig& cfg);
+
+// The reserve the planner keeps and the sampler relies on: override_reserve when any axis has a
+// jerk limit, else override_reserve_no_jerk.
+double override_reserve_in_effect(const PlannerConfig& cfg) noexcept;
 
 class Planner {
   public:
@@ -133,6 +140,7 @@ class Planner {
     std::size_t out_head_ = 0;
     std::uint32_t seq_ = 0;
     bool jerk_mode_ = false;
+    double reserve_ = 0;  // override_reserve_in_effect(cfg_)
 };
 
 }  // namespace motion

@@ -11,7 +11,12 @@
 // j r^3 within the rest. So any
 // override in [0, max_rate], any hold and any abort keeps every axis within its limits. While
 // slowing down the bounds on r' and r'' grow as a r^2 and j r^3 shrink (rate_limits_now()), so a
-// hold from full speed takes a few tenths of a second rather than 1 / r'max.
+// hold from full speed takes a few tenths of a second rather than 1 / r'max. Without a jerk
+// limit (r'' free, so r' may differ from one period to the next) each period also takes the
+// room the plan itself leaves over the stretch that period covers (room_limits(): the phases'
+// peak speed and acceleration against each axis's limit), in both directions; the planner then
+// keeps only a small fixed reserve (PlannerConfig::override_reserve_no_jerk), and a rate change
+// waits, where the plan uses nearly all of an axis's acceleration, until the plan leaves room.
 //
 // Two stops do not scale time but drive the path speed u directly, ignoring the jerk limit:
 // - fault_stop() (a drive fault, a limit switch, an e-stop) decelerates along the path at the
@@ -38,6 +43,7 @@ struct SamplerConfig {
     AxisLimits limits;
     double override_reserve = 0.1;        // must equal the planner's
     double max_rate = 1.2;                // must equal the planner's
+    double junction_share = 0.1;          // must equal the planner's
     std::size_t lookahead_records = 512;  // most records scanned for rate caps per period
 };
 SamplerConfig sampler_config(const PlannerConfig& p);
@@ -88,11 +94,17 @@ class Sampler {
     const SamplerStatus& status() const noexcept { return status_; }
 
   private:
-    double rate_target() const noexcept;
+    double rate_target(double dt) const noexcept;
     double current_override() const noexcept;
     double rate_cap_ahead() const noexcept;
+    double rate_cap_free(double dt) const noexcept;
+    double phase_room(const ElementBounds& b, const ProfilePhase& ph, double t_s,
+                      double r_hi) const noexcept;
     double integrate_rate(double target, double dt, const RateLimits& lim) noexcept;
+    double integrate_rate_free(double target, double dt, double max_rate_per_s) noexcept;
     RateLimits rate_limits_now(double target, double dt) const noexcept;
+    double room_rate(double from, double to, double r_hi) const noexcept;
+    RateLimits room_limits(const RateLimits& base, double target, double dt) const noexcept;
     void consume_finished_records() noexcept;
     bool pauses_at_block_end(const PreparedSegment& cur) const noexcept;
     enum class Brake : unsigned char { None, Fault, BlockEnd };
