@@ -75,6 +75,30 @@ TEST(Settings, SaveIntoMissingDirectoryFailsAndNamesThePath) {
     }
 }
 
+// The system-call failures name the file and the cause (strerror); the old file stays intact.
+TEST(Settings, FileSystemErrorsNameThePathAndTheCause) {
+    auto error_of_save = [](const std::string& path) {
+        try {
+            save_settings_atomic(path, Settings{});
+        } catch (const std::runtime_error& e) {
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    EXPECT_EQ(error_of_save("/nonexistent-dir-iback/s.txt"),
+              "/nonexistent-dir-iback/s.txt.tmp: cannot create temporary settings file: No such "
+              "file or directory");
+    // A directory in the way of the final name: rename(2) refuses, the temporary file goes.
+    const fs::path dir = temp_dir();
+    const fs::path target = dir / "settings.txt";
+    fs::create_directories(target / "sub");
+    EXPECT_EQ(error_of_save(target.string()),
+              target.string() + ": cannot replace settings file: Is a directory");
+    EXPECT_FALSE(fs::exists(target.string() + ".tmp"));
+    EXPECT_TRUE(fs::is_directory(target / "sub"));
+    fs::remove_all(dir);
+}
+
 TEST(Settings, ErrorsNameFileLineAndColumn) {
     EXPECT_EQ(error_of_settings("# ok\nwcs 1 0 0 0 0 0\n"),
               "s.txt:2:1: settings: 'wcs' needs 7 values, found 6");
@@ -126,7 +150,14 @@ TEST(ToolTable, OneTestPerErrorMessage) {
 }
 
 TEST(ToolTable, MissingFileIsAnError) {
-    EXPECT_THROW(load_linuxcnc_tool_table("/nonexistent-dir-iback/x.tbl"), Error);
+    try {
+        load_linuxcnc_tool_table("/nonexistent-dir-iback/x.tbl");
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("/nonexistent-dir-iback/x.tbl"), std::string::npos) << what;
+        EXPECT_NE(what.find("cannot open tool table"), std::string::npos) << what;
+    }
 }
 
 }  // namespace
