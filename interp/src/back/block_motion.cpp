@@ -302,6 +302,9 @@ cycles::CycleConfig BlockRun::cycle_config() const {
 
 void BlockRun::run_cycle() {
     if (!st.feed.feed_set || cfg_.use_default_speed) require_feed("a canned cycle");
+    // LEX-51: the dwell P is whole milliseconds, as for G04.
+    if (b_.has('P') && b_.get('P') != std::floor(b_.get('P')))
+        emit(canon::Warning{"canned-cycle P is in milliseconds; the fraction is kept"});
     std::optional<cycles::CycleCode> code;
     if (cycle_code_ && *cycle_code_ != gcode(80))
         code = cycles::cycle_code_from_g(*cycle_code_ / 10);

@@ -181,8 +181,10 @@ void BlockRun::step_dwell() {
     if (!g(gcode(4))) return;
     double seconds = 0;
     if (b_.has('P')) {
-        seconds = b_.get('P') / 1000.0;  // DW-1: P in milliseconds
-        if (!(b_.integer_literal_mask & (1u << letter_index('P'))))
+        const double ms = b_.get('P');
+        seconds = ms / 1000.0;  // DW-1: P in milliseconds
+        // LEX-51: whole milliseconds; `P1000.` and `P=#1` are fine, a real fraction is suspect.
+        if (ms != std::floor(ms))
             emit(canon::Warning{"G04 P is in milliseconds; the fraction is kept"});
     } else if (b_.has('X') && !any_axis_word()) {
         seconds = b_.get('X');

@@ -138,6 +138,20 @@ TEST_F(ExecTest, G00_4_DefaultSpeedErrors) {
     EXPECT_EQ(run({"G905 G01 X1 F60"}), (V{"feed-rate 1mm/s", "feed X1 Y0 Z0 programmed-feed"}));
 }
 
+// LEX-51: dwell P is whole milliseconds; a real fraction is kept with a warning (G04 and cycles),
+// a trailing decimal point alone is not a fraction.
+TEST_F(ExecTest, LEX_51_DwellFractionsWarn) {
+    const std::string g04 = "warning \"G04 P is in milliseconds; the fraction is kept\"";
+    EXPECT_EQ(run({"G04 P1.5"}), (V{g04, "dwell 0.0015s"}));
+    EXPECT_EQ(run({"G04 P1000."}), (V{"dwell 1s"}));
+    run({"G00 Z10"});
+    EXPECT_EQ(
+        run({"G82 X1 Y1 Z-1 R1 P2.5 F60"}),
+        (V{"feed-rate 1mm/s", "warning \"canned-cycle P is in milliseconds; the fraction is kept\"",
+           "traverse X1 Y1 Z10", "traverse X1 Y1 Z1", "feed X1 Y1 Z-1", "dwell 0.0025s",
+           "traverse X1 Y1 Z10"}));
+}
+
 TEST_F(ExecTest, FEED_8_FeedIsClampedWithOneWarningPerProgram) {
     BackendConfig cfg;
     cfg.max_feed_mm_s = 100;  // 6000 mm/min
