@@ -280,18 +280,21 @@ cycles::CycleWords BlockRun::cycle_words() const {
     return w;
 }
 
+// A machine setting readable as a named parameter: the persisted value (settings file, program
+// writes) first, then the machine configuration.
+std::optional<double> BlockRun::machine_setting(std::string_view name) const {
+    if (auto it = settings().params.find(name); it != settings().params.end()) return it->second;
+    if (auto it = cfg_.machine_settings.find(name); it != cfg_.machine_settings.end())
+        return it->second;
+    return std::nullopt;
+}
+
 // The cycle parameters of the machine, with the named-parameter settings (persisted or
 // configured) FIXEDCYCLE_BACK (δ of G73/G83, mm) and FIXEDCYCLE_OSS (G76/G87 shift direction)
 // taking precedence, so a public.dat or settings-file change reaches the built-in cycles too.
 cycles::CycleConfig BlockRun::cycle_config() const {
     cycles::CycleConfig c = cfg_.cycles;
-    auto setting = [&](std::string_view name) -> std::optional<double> {
-        if (auto it = settings().params.find(name); it != settings().params.end())
-            return it->second;
-        if (auto it = cfg_.machine_settings.find(name); it != cfg_.machine_settings.end())
-            return it->second;
-        return std::nullopt;
-    };
+    auto setting = [&](std::string_view name) { return machine_setting(name); };
     if (auto back = setting("FIXEDCYCLE_BACK")) c.retract_mm = *back;
     if (auto oss = setting("FIXEDCYCLE_OSS")) c.oss_direction = static_cast<int>(*oss);
     c.g76_shift_uv = cfg_.v54_compat;
@@ -453,11 +456,23 @@ void BlockRun::program_end(bool rewind) {
     const std::array<double, 3> before = st.tool.offset_mm;
     st.tool.offset_mm = {};
     if (before != st.tool.offset_mm) emit(canon::ToolOffset{st.tool.offset_mm});
-    if (cfg_.end_stops_spindle) {
+    // AUTOSTOPSPINDLE (S0 §4.1.2 #13) as a machine setting overrides the configured default.
+    const std::optional<double> autostop = machine_setting("AUTOSTOPSPINDLE");
+    if (autostop ? *autostop != 0 : cfg_.end_stops_spindle) {
         if (st.spindle.dir != SpindleDir::Stop) emit(canon::Spindle{SpindleDir::Stop});
         if (st.coolant.flood) emit(canon::Coolant{false});
         st.spindle.dir = SpindleDir::Stop;
         st.coolant.flood = false;
+    }
+    // M30-1, END-1: with ENABLE_CTP on, a normal end goes to the fixed point CTP_POS (machine
+    // coordinates, S0 §4.1.2 #19–22) as a G00 would, Z first when it rises; the spindle is
+    // already stopped when AUTOSTOPSPINDLE asks for it.
+    if (machine_setting("ENABLE_CTP").value_or(0) != 0) {
+        static constexpr std::string_view kCtp[3] = {"CTP_POS.X", "CTP_POS.Y", "CTP_POS.Z"};
+        AxisVec ctp = st.pos.machine_mm;
+        for (int a = 0; a < 3; ++a)
+            if (auto v = machine_setting(kCtp[a])) ctp[a] = *v;
+        emit_rapid(ctp);
     }
     announce_offsets();
     resync_prog();

@@ -6,6 +6,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "interp/executor.hpp"
@@ -173,6 +174,7 @@ class BlockRun {
     void require_no_scaling(int code) const;
     void require_no_mirror_coord_change() const;
     void require_feed(const char* what);
+    std::optional<double> machine_setting(std::string_view name) const;
     void select_feed(const char* what);
     void select_rapid();
 

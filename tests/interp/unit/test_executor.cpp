@@ -739,6 +739,24 @@ TEST_F(ExecTest, M30_1_EndResetsModalStateAndStopsSpindle) {
     EXPECT_EQ(run({"M02"}).back(), "program-end");
 }
 
+// M30-1 / END-1: ENABLE_CTP sends a normal end (M02, M30, end of input) to the fixed point
+// CTP_POS in machine coordinates, after the automatic spindle stop; AUTOSTOPSPINDLE=0 keeps the
+// spindle running. From (10,10,-5) to (-20,300,40): Z rises, so Z first.
+TEST_F(ExecTest, M30_1_EnableCtpGoesToTheFixedPointAtTheEnd) {
+    BackendConfig cfg;
+    cfg.machine_settings = {
+        {"ENABLE_CTP", 1}, {"CTP_POS.X", -20}, {"CTP_POS.Y", 300}, {"CTP_POS.Z", 40}};
+    make(cfg);
+    run({"G00 X10 Y10 Z-5 S100 M03"});
+    EXPECT_EQ(run({"M30"}), (V{"spindle stop", "traverse X10 Y10 Z40", "traverse X-20 Y300 Z40",
+                               "program-end rewind"}));
+    cfg.machine_settings = {{"AUTOSTOPSPINDLE", 0}};
+    make(cfg);
+    run({"S100 M03"});
+    EXPECT_EQ(run({"M02"}), (V{"program-end"}));
+    EXPECT_EQ(exec->state().spindle.dir, SpindleDir::Cw);
+}
+
 // TLC-6 REC (and END-1): length compensation is cancelled at program end.
 TEST_F(ExecTest, TLC_6_LengthCompEndsWithTheProgram) {
     Settings s;
