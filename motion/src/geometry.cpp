@@ -95,16 +95,19 @@ ElementBounds bounds(const Element& e) noexcept {
     ElementBounds b;
     switch (e.kind) {
         case ElementKind::Line:
-            for (int k = 0; k < kAxes; ++k) b.g1[k] = b.linear[k] = std::fabs(e.a[k]);
+            for (int k = 0; k < kAxes; ++k) {
+                b.g1[k] = b.linear[k] = std::fabs(e.a[k]);
+                b.g2[k] = b.g3[k] = b.tangential_in_plane[k] = 0;
+            }
             break;
         case ElementKind::Arc: {
             double k1 = std::fabs(e.sweep_rad / e.length_mm);
-            double r = e.radius_mm;
+            double r = e.radius_mm, inv_len = 1 / e.length_mm;
             for (int k = 0; k < kAxes; ++k) {
                 // amplitude of the rotating component
                 double q = std::sqrt(e.a[k] * e.a[k] + e.b[k] * e.b[k]);
                 b.tangential_in_plane[k] = r * k1 * q;
-                b.linear[k] = std::fabs(e.c[k]) / e.length_mm;
+                b.linear[k] = std::fabs(e.c[k]) * inv_len;
                 b.g1[k] = b.tangential_in_plane[k] + b.linear[k];
                 b.g2[k] = r * k1 * k1 * q;
                 b.g3[k] = r * k1 * k1 * k1 * q;
@@ -112,25 +115,28 @@ ElementBounds bounds(const Element& e) noexcept {
             break;
         }
         case ElementKind::Blend: {
-            double two_l = e.length_mm;
+            double inv_two_l = 1 / e.length_mm;
             for (int k = 0; k < kAxes; ++k) {
                 double t2 = e.a[k] + e.b[k];
                 b.g1[k] = b.linear[k] = std::max(std::fabs(e.a[k]), std::fabs(t2));
-                b.g2[k] = 1.5 * std::fabs(e.b[k]) / two_l;
-                b.g3[k] = 6 * std::fabs(e.b[k]) / (two_l * two_l);
+                b.g2[k] = 1.5 * std::fabs(e.b[k]) * inv_two_l;
+                b.g3[k] = 6 * std::fabs(e.b[k]) * inv_two_l * inv_two_l;
+                b.tangential_in_plane[k] = 0;
             }
             break;
         }
         case ElementKind::Bezier: {
             // A Bezier curve's derivatives are Bezier curves too and stay within the hull of
             // their control points.
-            double L = e.length_mm;
+            const double inv_l = 1 / e.length_mm;
+            const double s1 = 3 * inv_l, s2 = 6 * inv_l * inv_l, s3 = s2 * inv_l;
             for (int k = 0; k < kAxes; ++k) {
                 double d0 = e.a[k] - e.origin[k], d1 = e.b[k] - e.a[k], d2 = e.end[k] - e.b[k];
                 b.g1[k] = b.linear[k] =
-                    3 * std::max({std::fabs(d0), std::fabs(d1), std::fabs(d2)}) / L;
-                b.g2[k] = 6 * std::max(std::fabs(d1 - d0), std::fabs(d2 - d1)) / (L * L);
-                b.g3[k] = 6 * std::fabs(d2 - 2 * d1 + d0) / (L * L * L);
+                    s1 * std::max({std::fabs(d0), std::fabs(d1), std::fabs(d2)});
+                b.g2[k] = s2 * std::max(std::fabs(d1 - d0), std::fabs(d2 - d1));
+                b.g3[k] = s3 * std::fabs(d2 - 2 * d1 + d0);
+                b.tangential_in_plane[k] = 0;
             }
             break;
         }
@@ -292,9 +298,9 @@ Element trim_line(const Element& line, double from, double to) noexcept {
     return e;
 }
 
-std::optional<Element> make_corner_bezier(const AxisArray& p0, const AxisArray& t1,
-                                          const AxisArray& p3, const AxisArray& t2,
-                                          double l) noexcept {
+std::optional<BezierPoints> corner_bezier_points(const AxisArray& p0, const AxisArray& t1,
+                                                 const AxisArray& p3, const AxisArray& t2,
+                                                 double l) noexcept {
     const double h0 = 2.0 / 3 * l;
     double dd = 0, ds = 0, ss = 0;
     for (int k = 0; k < kAxes; ++k) {
@@ -320,12 +326,12 @@ std::optional<Element> make_corner_bezier(const AxisArray& p0, const AxisArray& 
         }
     }
     if (!(h > 0)) return std::nullopt;
-    AxisArray p1, p2;
+    BezierPoints b{p0, {}, {}, p3};
     for (int k = 0; k < kAxes; ++k) {
-        p1[k] = p0[k] + h * t1[k];
-        p2[k] = p3[k] - h * t2[k];
+        b.p1[k] = p0[k] + h * t1[k];
+        b.p2[k] = p3[k] - h * t2[k];
     }
-    return make_bezier(p0, p1, p2, p3);
+    return b;
 }
 
 namespace {
@@ -480,8 +486,8 @@ CornerPath corner_path(const Element& before, double before_mm, const Element& a
     return path;
 }
 
-bool bezier_within(const Element& bezier, const CornerPath& path, double limit_mm) noexcept {
-    const std::array<const AxisArray*, 4> ctrl{&bezier.origin, &bezier.a, &bezier.b, &bezier.end};
+bool bezier_within(const BezierPoints& bezier, const CornerPath& path, double limit_mm) noexcept {
+    const std::array<const AxisArray*, 4> ctrl{&bezier.p0, &bezier.p1, &bezier.p2, &bezier.p3};
     Hull piece;
     for (int i = 0; i < 4; ++i)
         for (int j = 0; j < path.dims; ++j) piece[i][j] = (*ctrl[i])[path.axes[j]];
@@ -489,11 +495,12 @@ bool bezier_within(const Element& bezier, const CornerPath& path, double limit_m
     double still_axes2 = 0;
     for (int k = 0; k < kAxes; ++k) {
         if (path.moving[k]) continue;
-        if (moves_axis(bezier, k)) {
+        const double x0 = bezier.p0[k];
+        if (bezier.p1[k] != x0 || bezier.p2[k] != x0 || bezier.p3[k] != x0) {
             for (int i = 0; i < 4; ++i) piece[i][dims] = (*ctrl[i])[k] - path.fixed[k];
             ++dims;
         } else {
-            still_axes2 += (bezier.origin[k] - path.fixed[k]) * (bezier.origin[k] - path.fixed[k]);
+            still_axes2 += (x0 - path.fixed[k]) * (x0 - path.fixed[k]);
         }
     }
     const Proof proof{path, limit_mm, still_axes2, dims};

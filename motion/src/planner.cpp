@@ -253,10 +253,10 @@ Planner::Junction Planner::bezier_corner(const Piece& p, const Piece& next, doub
         CurvePoint a, b;
         evaluate(p.geom, L1 - l, a);
         evaluate(next.geom, l, b);
-        std::optional<Element> curve = make_corner_bezier(a.p, a.d1, b.p, b.d1, l);
-        if (!curve || !bezier_within(*curve, path, allowed_mm)) continue;
+        std::optional<BezierPoints> ctrl = corner_bezier_points(a.p, a.d1, b.p, b.d1, l);
+        if (!ctrl || !bezier_within(*ctrl, path, allowed_mm)) continue;
         Junction jn{kInf, false, l, Blend::Curve};
-        jn.curve = *curve;
+        jn.curve = make_bezier(ctrl->p0, ctrl->p1, ctrl->p2, ctrl->p3);
         jn.curve_end_cap_mm_s = kInf;
         if (!jerk_mode_) return jn;  // without a jerk limit curvature steps cost nothing
         EndDerivs bs = start_derivs(jn.curve), be = end_derivs(jn.curve);

@@ -328,7 +328,7 @@ double sampled_deviation_mm(const Element& curve, const Element& piece1, const E
     return worst;
 }
 
-// Two lines: make_corner_bezier gives the parabola, whose largest distance from the lines is
+// Two lines: corner_bezier_points gives the parabola, whose largest distance from the lines is
 // (l / 4) sin(angle) (up to 90 degrees), at its middle. The proof is exact there: the middle is
 // the first split point and the halves' inner control points are closer to their lines.
 TEST(Geometry, CornerBezierProofIsExactForTheParabola) {
@@ -341,13 +341,14 @@ TEST(Geometry, CornerBezierProofIsExactForTheParabola) {
             far[k] += 3 * l * t2[k];
         }
         const Element before = make_line({0, 5, 1}, corner), after = make_line(corner, far);
-        std::optional<Element> b = make_corner_bezier(p0, t1, p3, t2, l);
+        std::optional<BezierPoints> b = corner_bezier_points(p0, t1, p3, t2, l);
         ASSERT_TRUE(b.has_value());
         const double dev = l / 4 * std::sin(a);
         const CornerPath path = corner_path(before, 2 * l, after, 2 * l, dev);
         EXPECT_TRUE(bezier_within(*b, path, dev * (1 + 1e-9))) << deg;
         EXPECT_FALSE(bezier_within(*b, path, dev * (1 - 1e-6))) << deg;
-        EXPECT_NEAR(sampled_deviation_mm(*b, before, after), dev, 1e-9);
+        const Element curve = make_bezier(b->p0, b->p1, b->p2, b->p3);
+        EXPECT_NEAR(sampled_deviation_mm(curve, before, after), dev, 1e-9);
     }
 }
 
@@ -355,7 +356,7 @@ TEST(Geometry, CornerBezierProofIsExactForTheParabola) {
 // along a straight path, P = (0,0) (1,1) (2,-1) (3,0), crosses the line at its middle but bulges
 // by y(u) = 3u (1-u) (1-2u), at most 1 / (2 sqrt 3) at u = 1/2 -+ 1 / sqrt 12.
 TEST(Geometry, BezierProofSeesTheBulgeBetweenSplitPoints) {
-    const Element s = make_bezier({0, 0}, {1, 1}, {2, -1}, {3, 0});
+    const BezierPoints s{{0, 0}, {1, 1}, {2, -1}, {3, 0}};
     const Element before = make_line({-1, 0}, {1.5, 0}), after = make_line({1.5, 0}, {4, 0});
     const double bulge = 1 / (2 * std::sqrt(3.0));
     const CornerPath path = corner_path(before, 2.5, after, 2.5, bulge);
@@ -386,7 +387,7 @@ TEST(Geometry, ArcChordsCarryTheirSagittaAsSlack) {
                 const double th = std::numbers::pi / 2 - phi * i / 200;
                 auto point = [&](double radius) {
                     const AxisArray p{radius * std::cos(th), radius * std::sin(th), 0};
-                    return make_bezier(p, p, p, p);
+                    return BezierPoints{p, p, p, p};
                 };
                 inside_passed += bezier_within(point(r - limit * (1 + 1e-6)), path, limit);
                 near_failed += !bezier_within(point(r - 0.95 * limit), path, limit);
@@ -438,15 +439,16 @@ TEST(Geometry, ArcCornerBezierAcceptedOnlyWithinTheLimit) {
             CurvePoint a, b;
             evaluate(m1, m1.length_mm - l, a);
             evaluate(m2, l, b);
-            return make_corner_bezier(a.p, a.d1, b.p, b.d1, l);
+            return corner_bezier_points(a.p, a.d1, b.p, b.d1, l);
         };
         double l_ok = 0;
         double l = l0;
         for (int attempt = 0; attempt < 12; ++attempt, l *= 0.7) {
-            std::optional<Element> curve = blend(l);
-            if (!curve) continue;
-            const bool ok = bezier_within(*curve, path, allowed);
-            const double dev = sampled_deviation_mm(*curve, piece1, piece2);
+            std::optional<BezierPoints> ctrl = blend(l);
+            if (!ctrl) continue;
+            const bool ok = bezier_within(*ctrl, path, allowed);
+            const double dev = sampled_deviation_mm(
+                make_bezier(ctrl->p0, ctrl->p1, ctrl->p2, ctrl->p3), piece1, piece2);
             if (dev < 0.9 * allowed) ++clearly_inside, clearly_inside_accepted += ok;
             if (!ok) continue;
             ASSERT_LE(dev, allowed * (1 + 1e-9))
@@ -459,10 +461,12 @@ TEST(Geometry, ArcCornerBezierAcceptedOnlyWithinTheLimit) {
         double l_bad = l_ok / 0.7;
         for (int step = 0; step < 12; ++step) {
             double mid = (l_ok + l_bad) / 2;
-            std::optional<Element> curve = blend(mid);
-            (curve && bezier_within(*curve, path, allowed) ? l_ok : l_bad) = mid;
+            std::optional<BezierPoints> ctrl = blend(mid);
+            (ctrl && bezier_within(*ctrl, path, allowed) ? l_ok : l_bad) = mid;
         }
-        const double dev = sampled_deviation_mm(*blend(l_ok), piece1, piece2);
+        const BezierPoints edge = *blend(l_ok);
+        const double dev =
+            sampled_deviation_mm(make_bezier(edge.p0, edge.p1, edge.p2, edge.p3), piece1, piece2);
         ASSERT_LE(dev, allowed * (1 + 1e-9))
             << "corner " << corners << " at the edge, l " << l_ok << " tolerance " << tol;
         closest = std::max(closest, dev / allowed);

@@ -46,9 +46,10 @@ struct Element {
     double sweep_rad = 0;  // signed, positive counter-clockwise from u towards w
 };
 
-// Position and its first three derivatives with respect to s.
+// Position and its first three derivatives with respect to s. evaluate() sets every member
+// (none is cleared first: the planner evaluates several points per corner).
 struct CurvePoint {
-    AxisArray p{}, d1{}, d2{}, d3{};
+    AxisArray p, d1, d2, d3;
 };
 
 // Realtime-safe: noexcept, no allocation, constant time.
@@ -57,9 +58,10 @@ void evaluate(const Element& e, double s_mm, CurvePoint& out) noexcept;
 // Per-axis bounds over the whole element: |p'_k| <= g1[k], |p''_k| <= g2[k], |p'''_k| <= g3[k].
 // For arcs, `tangential_in_plane[k]` and `linear[k]` split g1 so that the planner can use the
 // exact (rotating-vector) combination of tangential and centripetal acceleration.
+// bounds() sets every member (none is cleared first: it runs twice per planned element).
 struct ElementBounds {
-    AxisArray g1{}, g2{}, g3{};
-    AxisArray tangential_in_plane{}, linear{};
+    AxisArray g1, g2, g3;
+    AxisArray tangential_in_plane, linear;
 };
 ElementBounds bounds(const Element& e) noexcept;
 
@@ -95,13 +97,18 @@ Element trim_arc(const Element& arc, double from_mm, double to_mm) noexcept;
 // The line element trimmed to [from_mm, length - to_mm] of the original.
 Element trim_line(const Element& line, double from_mm, double to_mm) noexcept;
 
+// Control points of a cubic Bezier (make_bezier builds the element).
+struct BezierPoints {
+    AxisArray p0, p1, p2, p3;
+};
+
 // Corner blend for corners with an arc: a Bezier from p0 (unit tangent t1 there) to p3 (unit
 // tangent t2), its inner control points h along the tangents with h = 2/3 l (the parabola's, l
 // being the cut from each move), or the smallest larger h for which |p'| = 1 at both ends and
 // <= 1 inside (|p3 - p0 - h (t1 + t2)| <= h). None if no h fits.
-std::optional<Element> make_corner_bezier(const AxisArray& p0, const AxisArray& t1,
-                                          const AxisArray& p3, const AxisArray& t2,
-                                          double l_mm) noexcept;
+std::optional<BezierPoints> corner_bezier_points(const AxisArray& p0, const AxisArray& t1,
+                                                 const AxisArray& p3, const AxisArray& t2,
+                                                 double l_mm) noexcept;
 
 // The programmed path near a corner, for proving a blend's distance from it: the last
 // `before_mm` of `before` and the first `after_mm` of `after` (which starts where `before`
@@ -131,6 +138,6 @@ CornerPath corner_path(const Element& before, double before_mm, const Element& a
 // lie within limit_mm - slack of one chord (the distance to a segment is convex, so the hull's
 // farthest point is a control point). Gives up (false) at once when a split point cannot be
 // within reach of any chord, or after 6 levels of splitting. Noexcept, no allocation.
-bool bezier_within(const Element& bezier, const CornerPath& path, double limit_mm) noexcept;
+bool bezier_within(const BezierPoints& bezier, const CornerPath& path, double limit_mm) noexcept;
 
 }  // namespace motion
