@@ -133,11 +133,12 @@ struct CornerPath {
 CornerPath corner_path(const Element& before, double before_mm, const Element& after,
                        double after_mm, double limit_mm) noexcept;
 
-// True only if every point of the Bezier element is within limit_mm of the path: the curve is
-// split in halves (de Casteljau) until each piece's control points, whose hull holds the piece,
-// lie within limit_mm - slack of one chord (the distance to a segment is convex, so the hull's
+// True only if every point of the Bezier is within limit_mm of the path: the curve is split in
+// halves (de Casteljau) until each piece's control points, whose hull holds the piece, lie
+// within limit_mm - slack of one chord (the distance to a segment is convex, so the hull's
 // farthest point is a control point). Gives up (false) at once when a split point cannot be
-// within reach of any chord, or after 6 levels of splitting. Noexcept, no allocation.
+// within reach of any chord, or after 6 levels of splitting. Exact for axes the path does not
+// move (the blend's values there count as distance). Noexcept, no allocation.
 bool bezier_within(const BezierPoints& bezier, const CornerPath& path, double limit_mm) noexcept;
 
 }  // namespace motion
