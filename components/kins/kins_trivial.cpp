@@ -2,7 +2,10 @@
 // [coordinates=XYZ]`): joint N follows the axis named by the N-th letter of coordinates; a
 // letter given twice is a gantry (XYYZ: joints 1 and 2 both follow Y; Y's feedback comes from
 // joint 1). Without coordinates= every axis letter gets a joint in order, as trivkins does.
+#include <optional>
 #include <stdexcept>
+#include <string>
+#include <string_view>
 
 #include "kins_common.hpp"
 
@@ -19,8 +22,21 @@ class TrivialSource final : public motion::KinematicsSource {
     std::string coordinates_;
 };
 
+// LinuxCNC's kinstype= (its first letter: 1 identity, B both, F forward only, I inverse only)
+// tells LinuxCNC's motion whether joint and world mode coincide, for jogging and homing. Our
+// motion has neither mode switch nor homing, so the value changes nothing; it is checked so a
+// typo is not silently taken for identity, as LinuxCNC does.
+void check_kinstype(const std::optional<std::string>& kinstype) {
+    if (!kinstype) return;
+    const std::string_view accepted = "1bBfFiI";
+    if (kinstype->empty() || accepted.find(kinstype->front()) == std::string_view::npos)
+        throw hal::Error("kinstype=" + *kinstype +
+                         ": expected 1 (identity), B (both), F (forward only) or I (inverse only)");
+}
+
 struct KinsTrivial : kins::KinsInstance {
     KinsTrivial() {
+        check_kinstype(arg("kinstype"));
         const std::string coordinates = arg("coordinates").value_or("XYZABCUVW");
         try {
             build(std::make_shared<TrivialSource>(coordinates));
@@ -35,5 +51,5 @@ struct KinsTrivial : kins::KinsInstance {
 HAL_COMPONENT(kins_trivial, KinsTrivial,
               "Trivial kinematics: joint N follows the N-th letter of coordinates= (gantry: a "
               "letter twice)",
-              "coordinates")
+              "coordinates", "kinstype")
 KINS_MODULE(kins_trivial)

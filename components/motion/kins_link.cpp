@@ -103,6 +103,34 @@ KinsLink KinsLink::find(std::string_view name) {
     return link;
 }
 
+KinsLink KinsLink::automatic(std::string_view coordinates) {
+    std::vector<Module> modules = kinematics_modules();
+    std::vector<std::string> offered;
+    for (const Module& m : modules) {
+        for (const std::string& inst : m.entry->instances())
+            offered.push_back(fmt::format("{} ({})", inst, m.entry->name));
+        ::dlclose(m.library);
+    }
+    if (offered.empty()) return builtin(coordinates);
+    if (offered.size() > 1)
+        throw hal::Error(fmt::format(
+            "kins=auto: {} kinematics instances are loaded ({}); name the machine's with kins=NAME",
+            offered.size(), fmt::join(offered, ", ")));
+    return find(offered.front().substr(0, offered.front().find(' ')));
+}
+
+void KinsLink::keep_first_joints(std::size_t n) {
+    if (!kins_ || kins_->name() != "trivial")
+        throw hal::Error(fmt::format("{}: only a trivial kinematics can drop joints", name_));
+    const auto axes = kins_->joint_axes();
+    if (n < 1 || n > axes.size())
+        throw hal::Error(fmt::format("{}: keeps 1 to {} joints, not {}", name_, axes.size(), n));
+    static constexpr char kLetters[] = "XYZABCUVW";
+    std::string coordinates;
+    for (std::size_t j = 0; j < n; ++j) coordinates += kLetters[axes[j]];
+    kins_ = std::make_unique<motion::TrivialKinematics>(coordinates);
+}
+
 KinsLink::KinsLink(KinsLink&& o) noexcept
     : name_(std::move(o.name_)),
       library_(o.library_),

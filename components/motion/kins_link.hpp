@@ -17,6 +17,10 @@ class KinsLink {
     // Configuration world; both throw hal::Error with the reason.
     static KinsLink builtin(std::string_view coordinates);
     static KinsLink find(std::string_view name);
+    // kins=auto, LinuxCNC motmod's rule: the one kinematics instance loaded before motion, or
+    // the built-in trivial kinematics of `coordinates` when none is; two or more is an error
+    // naming them.
+    static KinsLink automatic(std::string_view coordinates);
 
     KinsLink(KinsLink&&) noexcept;
     KinsLink& operator=(KinsLink&&) = delete;
@@ -28,8 +32,14 @@ class KinsLink {
     // Realtime: reads the module's parameters (pivots, tool offset) into kins(). False once
     // the module's instance has been unloaded (kins() keeps the last parameters).
     bool refresh() noexcept { return !source_ || source_->refresh(*kins_); }
-    // "trivial" or the name kins= gave.
+    // "trivial" or the name of the instance used.
     const std::string& name() const noexcept { return name_; }
+    // True when a loaded kinematics instance computes the joints, false for the built-in one.
+    bool from_module() const noexcept { return source_ != nullptr; }
+    // Configuration world: keeps the first n joints of a trivial module's kinematics. LinuxCNC's
+    // trivkins has coordinates=XYZABCUVW by default and motmod's num_joints says how many of
+    // those joints exist. Throws hal::Error for other kinematics or n out of range.
+    void keep_first_joints(std::size_t n);
 
   private:
     KinsLink() = default;

@@ -130,6 +130,7 @@ class Motion : public hal::Instance {
         offset_after_mm_.assign(joint_count_, 0.0);
         pos_lim_seen_.assign(joint_count_, 0);
         neg_lim_seen_.assign(joint_count_, 0);
+        shared_function<&Motion::take_commands>("=motion-command-handler");
         shared_function<&Motion::update>("=motion-controller");
     }
 
@@ -183,16 +184,28 @@ class Motion : public hal::Instance {
         report_joint_excess();
     }
 
-    void update(hal::Period p) noexcept {
-        if (!sampler_) return;  // start() failed: nothing planned, nothing to command
-        const bool enable = enable_;
-        const bool enable_rose = enable && !enable_seen_;
-        enable_seen_ = enable;
+    // motion-command-handler (LinuxCNC's name and place: before motion-controller): takes the
+    // operator's commands of this period, motion.enable (a rising edge is the reset),
+    // motion.resume and the e-stop chain. motion-controller takes them itself in a period this
+    // function did not run in, so a thread without it works the same.
+    void take_commands(hal::Period) noexcept {
+        if (!sampler_) return;
+        enable_now_ = enable_;
+        const bool enable_rose = enable_now_ && !enable_seen_;
+        enable_seen_ = enable_now_;
         const bool resume = resume_;
         resume_rose_ = resume && !resume_seen_;
         resume_seen_ = resume;
         if (enable_rose) clear_latches();
         update_estop();
+        commands_taken_ = true;
+    }
+
+    void update(hal::Period p) noexcept {
+        if (!sampler_) return;  // start() failed: nothing planned, nothing to command
+        if (!commands_taken_) take_commands(p);
+        commands_taken_ = false;
+        const bool enable = enable_now_;
         check_limit_switches(enable);
         const bool faulted = drive_fault_ || limit_fault_ || estop_ == EStop::Tripped ||
                              program_fault_ || kins_lost_;
@@ -661,10 +674,19 @@ class Motion : public hal::Instance {
 
     // kins=NAME: the machine's kinematics module, loaded before motion; else the built-in
     // trivial kinematics of coordinates= (or num_joints=).
+    // kins=auto (what `loadrt motmod` gives): the one instance loaded, else the built-in.
     motioncomp::KinsLink link_kinematics() const {
+        check_linuxcnc_args();
         const auto kins = arg("kins");
         if (!kins) return motioncomp::KinsLink::builtin(read_coordinates());
-        auto link = motioncomp::KinsLink::find(*kins);
+        auto link = *kins == "auto" ? motioncomp::KinsLink::automatic(read_coordinates())
+                                    : motioncomp::KinsLink::find(*kins);
+        if (!link.from_module()) return link;
+        // LinuxCNC: `trivkins` (all nine letters) with num_joints=3 is an XYZ machine.
+        const long n = arg_int("num_joints", 0);
+        if (n > 0 && static_cast<std::size_t>(n) < link.kins().joint_count() &&
+            link.kins().name() == "trivial")
+            link.keep_first_joints(static_cast<std::size_t>(n));
         if (const auto c = arg("coordinates")) {
             const std::string want = axis_letters(link.kins());
             std::string given = upper(*c);
@@ -675,7 +697,7 @@ class Motion : public hal::Instance {
             if (given != want)
                 throw hal::Error(fmt::format(
                     "coordinates={} does not match kins={}, whose joints drive the axes {}", *c,
-                    *kins, want));
+                    link.name(), want));
         }
         return link;
     }
@@ -695,7 +717,23 @@ class Motion : public hal::Instance {
     // coordinates= as given for the built-in kinematics (a gantry's XYYZ), else the axes the
     // module's joints drive.
     std::string machine_coordinates() const {
-        return arg("kins") ? axis_letters(kins_.kins()) : read_coordinates();
+        return kins_.from_module() ? axis_letters(kins_.kins()) : read_coordinates();
+    }
+
+    // LinuxCNC motmod's module parameters that have no counterpart here (see motion.md,
+    // Loading as motmod): periods of threads this component does not make, the shared-memory
+    // key of a user-space link it does not have. Ones that would change the machine are
+    // accepted only at the value that means what we do.
+    void check_linuxcnc_args() const {
+        for (const char* ignored : {"base_period_nsec", "traj_period_nsec", "key", "base_thread_fp"})
+            (void)arg_int(ignored, 0);  // still checked: a number, as LinuxCNC's loader wants
+        if (const long n = arg_int("num_spindles", 1); n != 1)
+            throw hal::Error(fmt::format("num_spindles={}: motion has one spindle (spindle.0)", n));
+        if (const long n = arg_int("num_aio", 4); n < 1 || n > kMaxDio)
+            throw hal::Error(fmt::format("num_aio={}: must be 1 to {}", n, kMaxDio));
+        if (const long m = arg_int("unlock_joints_mask", 0); m != 0)
+            throw hal::Error(fmt::format(
+                "unlock_joints_mask={}: motion has no locking rotary joints (joint.N.unlock)", m));
     }
 
     std::size_t ring_capacity() const {
@@ -733,7 +771,7 @@ class Motion : public hal::Instance {
     void check_num_joints() const {
         const long n = arg_int("num_joints", static_cast<long>(joint_count_));
         if (n == static_cast<long>(joint_count_)) return;
-        if (arg("kins"))
+        if (kins_.from_module())
             throw hal::Error(fmt::format("num_joints={} does not match kins={} ({} joints)", n,
                                          kins_.name(), joint_count_));
         throw hal::Error(
@@ -883,6 +921,8 @@ class Motion : public hal::Instance {
     std::vector<JointExcess> joint_excess_;
     bool joints_primed_ = false;  // joint_prev_mm_ holds a real command
     bool excess_reported_ = false;
+    bool enable_now_ = false;      // motion.enable as taken by take_commands() this period
+    bool commands_taken_ = false;  // take_commands() ran since the last motion-controller
     bool kins_lost_ = false;  // latched for good: the geometry is gone
     motion::AxisArray action_pos_mm_{};  // this period's sampled position
     double tool_offset_z_mm_ = 0;        // motion.tooloffset.z as last written
@@ -918,4 +958,5 @@ class Motion : public hal::Instance {
 
 HAL_COMPONENT(motion, Motion, "Trajectory planner and servo-rate motion controller", "num_joints",
               "coordinates", "kins", "program", "canon", "dialect", "servo_period_nsec", "queue", "sim_lockstep",
-              "num_dio")
+              "num_dio", "base_period_nsec", "traj_period_nsec", "num_aio", "num_spindles", "key",
+              "base_thread_fp", "unlock_joints_mask")

@@ -9,6 +9,9 @@
 #include <csignal>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
 #include <set>
 
 #include <fmt/format.h>
@@ -577,20 +580,129 @@ std::vector<std::string> available_components(const std::vector<std::string>& di
     for (auto& d : dirs) {
         std::error_code ec;
         for (auto& e : std::filesystem::directory_iterator(d, ec))
-            if (e.path().extension() == ".so") names.push_back(e.path().stem().string());
+            if (e.path().extension() == ".so" || e.path().extension() == ".alias")
+                names.push_back(e.path().stem().string());
     }
     return names;
+}
+
+// A LinuxCNC module name that one of our components answers to: `<name>.alias` beside the
+// components says which component to load and with what, so `loadrt trivkins coordinates=XYZ`
+// loads kins_trivial with `names=trivkins` added. Its lines ('#' starts a comment):
+//
+//   COMPONENT [KEY=VALUE ...]     the component; KEY=VALUEs are defaults for keys the loadrt
+//                                 line does not give
+//   thread NAME KEY [DEFAULT_NS]  after loading, create thread NAME (floating point allowed)
+//                                 with the period the loadrt line gives in KEY, else
+//                                 DEFAULT_NS; none if neither, or 0 (LinuxCNC's motmod makes
+//                                 servo-thread and base-thread from its period arguments)
+//
+// The file lives with the component it names (its CMakeLists copies it here), so the runtime
+// knows no component by name. The first folder holding `<name>.so` or `<name>.alias` decides,
+// a .so first: a real component of that name always wins.
+struct AliasThread {
+    std::string name, key, fallback_ns;
+};
+
+struct Alias {
+    std::string path;
+    std::string target;
+    std::vector<std::string> args;
+    std::vector<AliasThread> threads;
+};
+
+Alias read_alias(const std::string& path, std::istream& in) {
+    Alias alias{path, {}, {}, {}};
+    std::string line;
+    for (int number = 1; std::getline(in, line); ++number) {
+        std::istringstream words(line.substr(0, line.find('#')));
+        std::vector<std::string> w;
+        for (std::string word; words >> word;) w.push_back(word);
+        if (w.empty()) continue;
+        if (w[0] == "thread") {
+            if (w.size() < 3 || w.size() > 4)
+                throw Error(fmt::format("{}:{}: expected 'thread NAME KEY [DEFAULT_NS]'", path, number));
+            alias.threads.push_back({w[1], w[2], w.size() == 4 ? w[3] : ""});
+        } else if (alias.target.empty() && w[0].find('/') == std::string::npos) {
+            alias.target = w[0];
+            alias.args.assign(w.begin() + 1, w.end());
+        } else {
+            throw Error(fmt::format("{}:{}: expected one line 'COMPONENT [KEY=VALUE ...]'", path, number));
+        }
+    }
+    if (alias.target.empty()) throw Error(fmt::format("{}: names no component", path));
+    return alias;
+}
+
+std::optional<Alias> find_alias(const std::string& name, const std::vector<std::string>& dirs) {
+    if (name.find('/') != std::string::npos) return std::nullopt;
+    for (auto& d : dirs) {
+        if (std::filesystem::exists(fmt::format("{}/{}.so", d, name))) return std::nullopt;
+        const auto path = fmt::format("{}/{}.alias", d, name);
+        std::ifstream in(path);
+        if (in) return read_alias(path, in);
+    }
+    return std::nullopt;
+}
+
+// The threads an alias makes, with their periods from the merged loadrt arguments.
+std::vector<std::pair<std::string, std::int64_t>> alias_threads(const Alias& alias,
+                                                                 const std::vector<std::string>& merged) {
+    std::vector<std::pair<std::string, std::int64_t>> out;
+    for (auto& t : alias.threads) {
+        std::string value = t.fallback_ns;
+        for (auto& m : merged)
+            if (auto [k, v] = split_arg(m); k == t.key) value = v;
+        if (value.empty()) continue;
+        auto period = parse_value(Type::S64, value);
+        if (!period || period->s64 < 0)
+            throw Error(fmt::format("{}={}: not a number of nanoseconds", t.key, value));
+        if (period->s64 > 0) out.emplace_back(t.name, period->s64);
+    }
+    return out;
+}
+
+// The alias's defaults for the keys the line leaves out, then the line's own arguments.
+std::vector<std::string> merge_alias_args(const Alias& alias, const std::vector<std::string>& given) {
+    std::vector<std::string> out;
+    for (auto& d : alias.args) {
+        const auto key = split_arg(d).first;
+        const bool overridden = std::any_of(given.begin(), given.end(), [&](const std::string& g) {
+            return g.compare(0, key.size() + 1, key + "=") == 0;
+        });
+        if (!overridden) out.push_back(d);
+    }
+    out.insert(out.end(), given.begin(), given.end());
+    return out;
 }
 }  // namespace
 
 void Runtime::cmd_loadrt(const std::vector<std::string>& a, std::string& out) {
     std::vector<std::string> args(a.begin() + 1, a.end());
     try {
-        if (a[0] == "threads") load_threads_component(args);
-        else load_component(a[0], args);
+        if (a[0] == "threads") {
+            load_threads_component(args);
+        } else if (auto alias = find_alias(a[0], component_dirs())) {
+            if (find_alias(alias->target, component_dirs()))
+                throw Error(fmt::format("{}: names another alias, '{}'; name a component", alias->path,
+                                        alias->target));
+            const auto merged = merge_alias_args(*alias, args);
+            load_alias(alias->target, merged, alias_threads(*alias, merged));
+        } else {
+            load_component(a[0], args);
+        }
     } catch (const Error& e) {
         throw Error(fmt::format("loadrt {}: {}", a[0], e.what()));
     }
+}
+
+void Runtime::load_alias(const std::string& target, const std::vector<std::string>& args,
+                         const std::vector<std::pair<std::string, std::int64_t>>& threads) {
+    // Threads are checked before and made after the component: a failure leaves nothing behind.
+    for (auto& [name, period_ns] : threads)
+        if (threads_.count(name)) throw Error(fmt::format("thread '{}' already exists", name));
+    load_component(target, args);
+    for (auto& [name, period_ns] : threads) create_thread(name, period_ns, true, -1);
 }
 
 void Runtime::load_threads_component(const std::vector<std::string>& args) {

@@ -239,6 +239,10 @@ private:
 
     void load_threads_component(const std::vector<std::string>& a);
     void load_component(const std::string& name, const std::vector<std::string>& args);
+    // A LinuxCNC module name's alias file resolved (runtime.cpp, find_alias): the component,
+    // its arguments, and the threads to make once it has loaded.
+    void load_alias(const std::string& target, const std::vector<std::string>& args,
+                    const std::vector<std::pair<std::string, std::int64_t>>& threads);
     void unload_component(Component& c);
     Thread& create_thread(const std::string& name, std::int64_t period_ns, bool fp, int cpu);
 

@@ -241,7 +241,9 @@ def main():
                     help="LinuxCNC's halrun: also load every file we load with it, as the reference")
     a = ap.parse_args()
 
-    ours = {f[:-3] for f in os.listdir(a.components) if f.endswith(".so")} | {"threads"}
+    # LinuxCNC module names we answer to through <name>.alias files (trivkins, motmod) count too.
+    ours = {os.path.splitext(f)[0] for f in os.listdir(a.components)
+            if f.endswith(".so") or f.endswith(".alias")} | {"threads"}
     our_programs = set(a.programs.split(","))
     files, inis = [], []
     for root, _, names in os.walk(a.tree):
