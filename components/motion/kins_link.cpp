@@ -119,16 +119,15 @@ KinsLink KinsLink::automatic(std::string_view coordinates) {
     return find(offered.front().substr(0, offered.front().find(' ')));
 }
 
-void KinsLink::keep_first_joints(std::size_t n) {
-    if (!kins_ || kins_->name() != "trivial")
-        throw hal::Error(fmt::format("{}: only a trivial kinematics can drop joints", name_));
+bool KinsLink::keep_first_joints_of_identity(std::size_t n) {
+    if (!kins_ || kins_->name() != "trivial") return false;
     const auto axes = kins_->joint_axes();
-    if (n < 1 || n > axes.size())
-        throw hal::Error(fmt::format("{}: keeps 1 to {} joints, not {}", name_, axes.size(), n));
-    static constexpr char kLetters[] = "XYZABCUVW";
-    std::string coordinates;
-    for (std::size_t j = 0; j < n; ++j) coordinates += kLetters[axes[j]];
-    kins_ = std::make_unique<motion::TrivialKinematics>(coordinates);
+    if (axes.size() != static_cast<std::size_t>(motion::kAxes) || n < 1 || n >= axes.size())
+        return false;
+    for (std::size_t j = 0; j < axes.size(); ++j)
+        if (axes[j] != static_cast<int>(j)) return false;
+    kins_ = std::make_unique<motion::TrivialKinematics>(std::string("XYZABCUVW").substr(0, n));
+    return true;
 }
 
 KinsLink::KinsLink(KinsLink&& o) noexcept

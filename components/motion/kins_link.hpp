@@ -36,10 +36,11 @@ class KinsLink {
     const std::string& name() const noexcept { return name_; }
     // True when a loaded kinematics instance computes the joints, false for the built-in one.
     bool from_module() const noexcept { return source_ != nullptr; }
-    // Configuration world: keeps the first n joints of a trivial module's kinematics. LinuxCNC's
-    // trivkins has coordinates=XYZABCUVW by default and motmod's num_joints says how many of
-    // those joints exist. Throws hal::Error for other kinematics or n out of range.
-    void keep_first_joints(std::size_t n);
+    // Configuration world. LinuxCNC's trivkins without coordinates= drives all nine axes
+    // XYZABCUVW, one joint each, and motmod's num_joints says how many of those joints exist:
+    // keeps the first n (1 to 8) joints of such a kinematics and returns true; false, changing
+    // nothing, for any other kinematics (a gantry's XYYZ must match num_joints exactly).
+    bool keep_first_joints_of_identity(std::size_t n);
 
   private:
     KinsLink() = default;

@@ -683,10 +683,8 @@ class Motion : public hal::Instance {
                                     : motioncomp::KinsLink::find(*kins);
         if (!link.from_module()) return link;
         // LinuxCNC: `trivkins` (all nine letters) with num_joints=3 is an XYZ machine.
-        const long n = arg_int("num_joints", 0);
-        if (n > 0 && static_cast<std::size_t>(n) < link.kins().joint_count() &&
-            link.kins().name() == "trivial")
-            link.keep_first_joints(static_cast<std::size_t>(n));
+        if (const long n = arg_int("num_joints", 0); n > 0)
+            link.keep_first_joints_of_identity(static_cast<std::size_t>(n));
         if (const auto c = arg("coordinates")) {
             const std::string want = axis_letters(link.kins());
             std::string given = upper(*c);
