@@ -24,13 +24,16 @@ namespace interp {
 struct TokenCursor {
     const std::vector<Token>* tokens = nullptr;
     std::size_t pos = 0;
-    const Token& peek(std::size_t ahead = 0) const {
+    // The lexer ends every line's tokens with one Tok::End and the cursor never moves past it,
+    // so the current token needs no bounds check.
+    const Token& peek() const { return (*tokens)[pos]; }
+    const Token& peek(std::size_t ahead) const {
         const std::size_t i = pos + ahead;
         return i < tokens->size() ? (*tokens)[i] : tokens->back();
     }
     const Token& next() {
         const Token& t = peek();
-        if (pos + 1 < tokens->size()) ++pos;
+        if (t.kind != Tok::End) ++pos;
         return t;
     }
     bool at_end() const { return peek().kind == Tok::End; }

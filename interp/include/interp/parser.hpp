@@ -53,6 +53,7 @@ class BlockParser {
     void parse_keyword(Ctx& c, const Token& word);
     void parse_assignment(Ctx& c, const Token& var);
     double parse_value(Ctx& c, const Token& address, bool* integer_literal);
+    double parse_signed_or_expression(Ctx& c, const Token& address, bool* integer_literal);
     int parse_plc_address(Ctx& c, const Token& keyword);
 
     const Dialect* dialect_;

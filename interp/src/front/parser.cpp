@@ -109,6 +109,12 @@ double BlockParser::parse_value(Ctx& c, const Token& address, bool* integer_lite
         if (integer_literal != nullptr) *integer_literal = !t.has_point;
         return t.number;
     }
+    return parse_signed_or_expression(c, address, integer_literal);
+}
+
+double BlockParser::parse_signed_or_expression(Ctx& c, const Token& address,
+                                               bool* integer_literal) {
+    const Token& t = c.cur.peek();
     if (t.kind == Tok::Op && t.op == Op::Assign) {
         c.cur.next();
         const Token& e = c.cur.peek();
@@ -139,7 +145,6 @@ double BlockParser::parse_value(Ctx& c, const Token& address, bool* integer_lite
 
 void BlockParser::parse_letter(Ctx& c, const Token& letter) {
     const char L = to_upper(letter.text[0]);
-    const SourceLoc at = c.at(letter);
     Block& b = c.block();
     if (L == 'O') {
         const Token& t = c.cur.next();
@@ -155,11 +160,11 @@ void BlockParser::parse_letter(Ctx& c, const Token& letter) {
         } else if (t.kind == Tok::Number && !t.has_point) {
             c.out.label_number = to_integer(t.number, c.at(t), "program number");
         } else {
-            throw Error(at, "O must be followed by a program number or a \"name\"");
+            throw Error(c.at(letter), "O must be followed by a program number or a \"name\"");
         }
         const Token& rest = c.cur.peek();
         if (rest.kind != Tok::End || !b.empty() || b.n || letter.col != c.loc.col) {
-            throw Error(rest.kind != Tok::End ? c.at(rest) : at,
+            throw Error(rest.kind != Tok::End ? c.at(rest) : c.at(letter),
                         "a subprogram label O… must stand alone on its line");
         }
         c.out.is_label = true;
@@ -168,7 +173,8 @@ void BlockParser::parse_letter(Ctx& c, const Token& letter) {
     if (L == 'P' && c.cur.peek().kind == Tok::String) {
         const Token& t = c.cur.next();
         if (c.dry) return;
-        if (c.out.p_name || b.has('P')) throw Error(at, "word P appears twice in one block");
+        if (c.out.p_name || b.has('P'))
+            throw Error(c.at(letter), "word P appears twice in one block");
         c.out.p_name = std::string(t.text);
         c.out.p_name_col = letter.col;
         return;
@@ -181,33 +187,34 @@ void BlockParser::parse_letter(Ctx& c, const Token& letter) {
             const double scaled = v * 10.0;
             const double r = std::nearbyint(scaled);
             if (std::fabs(scaled - r) > 1e-6) {
-                throw Error(at, "G code G" + fmt::format("{}", v) + " has more than one decimal");
+                throw Error(c.at(letter),
+                            "G code G" + fmt::format("{}", v) + " has more than one decimal");
             }
-            if (r < 0 || r > 1e7) throw Error(at, "G code out of range");
+            if (r < 0 || r > 1e7) throw Error(c.at(letter), "G code out of range");
             if (!b.g.push_back(static_cast<int>(r)) || !b.g_col.push_back(letter.col)) {
-                throw Error(at, "too many G codes in one block");
+                throw Error(c.at(letter), "too many G codes in one block");
             }
             return;
         }
         case 'M': {
-            const int m = to_int32(v, at, "M code");
-            if (m < 0) throw Error(at, "M code must not be negative");
+            const int m = to_int32(v, c.at(letter), "M code");
+            if (m < 0) throw Error(c.at(letter), "M code must not be negative");
             if (!b.m.push_back(m) || !b.m_col.push_back(letter.col)) {
-                throw Error(at, "too many M codes in one block");
+                throw Error(c.at(letter), "too many M codes in one block");
             }
             return;
         }
         case 'N': {
-            if (b.n) throw Error(at, "a block can have only one sequence number N");
-            const std::int64_t n = to_integer(v, at, "sequence number N");
-            if (n < 0) throw Error(at, "sequence number N must not be negative");
+            if (b.n) throw Error(c.at(letter), "a block can have only one sequence number N");
+            const std::int64_t n = to_integer(v, c.at(letter), "sequence number N");
+            if (n < 0) throw Error(c.at(letter), "sequence number N must not be negative");
             b.n = n;
             return;
         }
         default: {
             const int i = letter_index(L);
             if (b.words[i] || (L == 'P' && c.out.p_name)) {
-                throw Error(at, std::string("word ") + L + " appears twice in one block");
+                throw Error(c.at(letter), std::string("word ") + L + " appears twice in one block");
             }
             b.words[i] = v;
             b.word_col[i] = letter.col;
