@@ -103,7 +103,8 @@ void BlockRun::move_arc(bool ccw) {
     require_feed("an arc");
     const PlaneAxes pa = plane_axes(st.motion.plane);
     // The arc starts where the machine is, seen in the current program frame.
-    const AxisVec start = prog_of_machine(st.pos.machine_mm);
+    const AxisVec offset = offset_total();
+    const AxisVec start = prog_of_machine(st.pos.machine_mm, offset);
     AxisVec end = st.pos.prog_mm;
     for (int a = 0; a < kMachineAxes; ++a)
         if (has_axis(a)) end[a] = st.motion.incremental ? start[a] + axis_value(a) : axis_value(a);
@@ -172,8 +173,8 @@ void BlockRun::move_arc(bool ccw) {
     AxisVec centre_prog = start;
     centre_prog[pa.first] = r.centre.x();
     centre_prog[pa.second] = r.centre.y();
-    const AxisVec centre_m = to_machine(centre_prog);
-    const AxisVec end_m = to_machine(end);
+    const AxisVec centre_m = to_machine(centre_prog, offset);
+    const AxisVec end_m = to_machine(end, offset);
 
     canon::Arc arc;
     arc.plane = mp;

@@ -76,9 +76,6 @@ class BlockRun {
     std::optional<Settings> settings_copy;
 
   private:
-    using Step = void (BlockRun::*)();
-    static const Step kSteps[];
-
     // --- steps, in execution order ---
     void validate();
     void announce_start();
@@ -165,8 +162,14 @@ class BlockRun {
     }
 
     AxisVec offset_total() const;
-    AxisVec to_machine(const AxisVec& prog) const;
-    AxisVec prog_of_machine(const AxisVec& machine) const;
+    // Program <-> machine coordinates; `offset` is offset_total(), which a block that converts
+    // several points computes once.
+    AxisVec to_machine(const AxisVec& prog, const AxisVec& offset) const;
+    AxisVec prog_of_machine(const AxisVec& machine, const AxisVec& offset) const;
+    AxisVec to_machine(const AxisVec& prog) const { return to_machine(prog, offset_total()); }
+    AxisVec prog_of_machine(const AxisVec& machine) const {
+        return prog_of_machine(machine, offset_total());
+    }
     void resync_prog() { st.pos.prog_mm = prog_of_machine(st.pos.machine_mm); }
     void announce_offsets();
     void update_tool_offset(const SourceLoc& loc);

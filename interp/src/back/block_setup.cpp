@@ -21,13 +21,12 @@ void BlockRun::step_units() {
 // Announced after the plane, in LinuxCNC's order, though the value applied from the start of the
 // block (F and every length of the block are in the new units).
 void BlockRun::announce_units() {
-    if (g(gcode(20)) || g(gcode(70)) || g(gcode(21)) || g(gcode(71)))
-        emit(canon::Units{st.units.inch()});
+    if (group(GGroup::Units)) emit(canon::Units{st.units.inch()});  // G20/G21/G70/G71
 }
 
 // F in a block whose motion mode is G00 sets the rapid speed only (G00-3).
 void BlockRun::step_feed() {
-    if (g(gcode(94))) emit(canon::SetFeedMode{true});
+    if (group(GGroup::FeedMode) && g(gcode(94))) emit(canon::SetFeedMode{true});
     if (!b_.has('F')) return;
     const double f = b_.get('F');
     if (f < 0) fail(b_.loc_of('F'), fmt::format("negative feed rate F{}", fmt_num(f)));
@@ -233,9 +232,11 @@ void BlockRun::step_tool_length() {
 // G40/G41/G42 and D (CRC-1, CRC-7, EX-35: D alone only selects the radius).
 void BlockRun::step_cutter_comp() {
     if (b_.has('D')) st.crc_d = int_word('D', 0, 99999, "cutter radius register");
-    if (g(gcode(40))) st.crc_side = cutter::Side::Off;
-    if (g(gcode(41))) st.crc_side = cutter::Side::Left;
-    if (g(gcode(42))) st.crc_side = cutter::Side::Right;
+    if (group(GGroup::Crc)) {
+        if (g(gcode(40))) st.crc_side = cutter::Side::Off;
+        if (g(gcode(41))) st.crc_side = cutter::Side::Left;
+        if (g(gcode(42))) st.crc_side = cutter::Side::Right;
+    }
     if (st.crc_side == cutter::Side::Off) return;
     const int reg = st.crc_d.value_or(st.tool.current);
     double radius = 0;

@@ -86,19 +86,33 @@ std::string mname(int code) {
     return code < 10 ? fmt::format("M{:02d}", code) : fmt::format("M{}", code);
 }
 
-const BlockRun::Step BlockRun::kSteps[] = {
-    &BlockRun::validate,           &BlockRun::announce_start,     &BlockRun::step_units,
-    &BlockRun::step_feed,          &BlockRun::step_spindle_speed, &BlockRun::step_tool,
-    &BlockRun::step_spindle,       &BlockRun::step_coolant,       &BlockRun::step_io,
-    &BlockRun::step_dwell,         &BlockRun::step_plane,         &BlockRun::announce_units,
-    &BlockRun::step_cutter_comp,   &BlockRun::step_tool_length,   &BlockRun::step_wcs,
-    &BlockRun::step_path_mode,     &BlockRun::step_distance,      &BlockRun::step_transforms,    &BlockRun::step_settings_writes,
-    &BlockRun::step_machine_codes, &BlockRun::step_cycle_modes,   &BlockRun::step_motion,
-    &BlockRun::step_stop,          &BlockRun::step_crc_effective,
-};
-
+// The steps in execution order. Called directly rather than through a table of member pointers:
+// a block runs all 24 of them, and most return at once.
 void BlockRun::run() {
-    for (Step s : kSteps) (this->*s)();
+    validate();
+    announce_start();
+    step_units();
+    step_feed();
+    step_spindle_speed();
+    step_tool();
+    step_spindle();
+    step_coolant();
+    step_io();
+    step_dwell();
+    step_plane();
+    announce_units();
+    step_cutter_comp();
+    step_tool_length();
+    step_wcs();
+    step_path_mode();
+    step_distance();
+    step_transforms();
+    step_settings_writes();
+    step_machine_codes();
+    step_cycle_modes();
+    step_motion();
+    step_stop();
+    step_crc_effective();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -153,11 +167,13 @@ void BlockRun::validate() {
         }
     }
     if (b_.msg && !m(801)) fail(b_.loc, "MSG is only allowed with M801");
-    flags_.force_full_override = g(gcode(903));
-    flags_.force_programmed_feed = g(gcode(905));
-    flags_.rotary_shortest_path = g(gcode(907));
-    flags_.rotary_degrees = g(gcode(908));
-    flags_.exact_stop = g(gcode(9));
+    if (group(GGroup::Flag)) {  // G09, G53, G903, G905, G907, G908: most blocks have none
+        flags_.force_full_override = g(gcode(903));
+        flags_.force_programmed_feed = g(gcode(905));
+        flags_.rotary_shortest_path = g(gcode(907));
+        flags_.rotary_degrees = g(gcode(908));
+        flags_.exact_stop = g(gcode(9));
+    }
     require_no_mirror_coord_change();
 }
 
@@ -179,8 +195,7 @@ AxisVec BlockRun::offset_total() const {
     return t;
 }
 
-AxisVec BlockRun::to_machine(const AxisVec& prog) const {
-    const AxisVec off = offset_total();
+AxisVec BlockRun::to_machine(const AxisVec& prog, const AxisVec& off) const {
     AxisVec m{};
     if (xf().identity()) {  // the common case: no affine product needed
         for (int a = 0; a < kMachineAxes; ++a) m[a] = prog[a] + off[a];
@@ -191,8 +206,7 @@ AxisVec BlockRun::to_machine(const AxisVec& prog) const {
     return m;
 }
 
-AxisVec BlockRun::prog_of_machine(const AxisVec& machine) const {
-    const AxisVec off = offset_total();
+AxisVec BlockRun::prog_of_machine(const AxisVec& machine, const AxisVec& off) const {
     AxisVec w{};
     for (int a = 0; a < kMachineAxes; ++a) w[a] = machine[a] - off[a];
     const Eigen::Vector3d p = xf().identity() ? xyz(w) : xf().inverse(xyz(w));
