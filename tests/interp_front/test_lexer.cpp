@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "interp/expr.hpp"
 #include "interp/lexer.hpp"
 
 using namespace interp;
@@ -197,4 +198,21 @@ TEST(Lexer, ColumnsCountCharactersAfterChineseText) {
 
 TEST(Lexer, ErrorColumnAfterChineseComment) {
     EXPECT_EQ(lex_error("(注释) X1 $"), "t.nc:7:9: unexpected character '$'");
+}
+
+// The token cursor reads its current token without a bounds check; that is safe only because
+// every lexed line ends with exactly one Tok::End and next() never moves past it.
+TEST(Lexer, EveryLineEndsWithOneEndTokenTheCursorStopsAt) {
+    for (std::string_view line : {"", "   ", "; only a comment", "G1 X1.5 Y-2", "(c) #1=[2*3]", "%",
+                                  "N10 G0 X0 ' quote comment"}) {
+        const std::vector<Token> t = lex(line);
+        ASSERT_FALSE(t.empty()) << line;
+        EXPECT_EQ(t.back().kind, Tok::End) << line;
+        for (std::size_t i = 0; i + 1 < t.size(); ++i) EXPECT_NE(t[i].kind, Tok::End) << line;
+        TokenCursor cur{&t, 0};
+        for (std::size_t i = 0; i < t.size() + 3; ++i) cur.next();
+        EXPECT_EQ(cur.pos, t.size() - 1) << line;
+        EXPECT_EQ(cur.peek().kind, Tok::End) << line;
+        EXPECT_TRUE(cur.at_end()) << line;
+    }
 }
