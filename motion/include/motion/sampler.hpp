@@ -30,7 +30,9 @@
 // the constructor. One thread drives advance(); the controls may be called from the same thread.
 #pragma once
 
+#include <array>
 #include <cstddef>
+#include <vector>
 
 #include "motion/planner.hpp"
 #include "motion/prepared.hpp"
@@ -44,7 +46,9 @@ struct SamplerConfig {
     double override_reserve = 0.1;        // must equal the planner's
     double max_rate = 1.2;                // must equal the planner's
     double junction_share = 0.1;          // must equal the planner's
-    std::size_t lookahead_records = 512;  // most records scanned for rate caps per period
+    // Most records scanned for rate caps per period; also the size of the per-record room cache
+    // the constructor allocates (jerk unlimited: each record's rooms are computed once).
+    std::size_t lookahead_records = 512;
 };
 SamplerConfig sampler_config(const PlannerConfig& p);
 
@@ -94,10 +98,10 @@ class Sampler {
     const SamplerStatus& status() const noexcept { return status_; }
 
   private:
-    double rate_target(double dt) const noexcept;
+    double rate_target(double dt) noexcept;
     double current_override() const noexcept;
     double rate_cap_ahead() const noexcept;
-    double rate_cap_free(double dt) const noexcept;
+    double rate_cap_free(double dt) noexcept;
     double phase_room(const ElementBounds& b, const ProfilePhase& ph, double t_s,
                       double r_hi) const noexcept;
     double integrate_rate(double target, double dt, const RateLimits& lim) noexcept;
@@ -106,6 +110,16 @@ class Sampler {
     double room_rate(double from, double to, double r_hi) const noexcept;
     RateLimits room_limits(const RateLimits& base, double target, double dt) const noexcept;
     void consume_finished_records() noexcept;
+    // Every pop of the ring goes through here, so the room cache stays aligned with the ring.
+    void pop_front() noexcept;
+    // phase_room() of each phase of one record at the highest rate (what rate_cap_free() needs),
+    // computed once per record instead of once per period: records never change in the ring.
+    struct PhaseRooms {
+        const PreparedSegment* rec = nullptr;  // the ring slot it was computed for (a guard)
+        std::array<double, kMaxPhases> room_per_s{};
+    };
+    const PhaseRooms& rooms_of(std::size_t i) noexcept;
+    void warm_rooms(std::size_t count) noexcept;
     bool pauses_at_block_end(const PreparedSegment& cur) const noexcept;
     enum class Brake : unsigned char { None, Fault, BlockEnd };
     void start_brake(Brake kind) noexcept;
@@ -137,6 +151,11 @@ class Sampler {
     double brake_s_mm_ = 0;    // position within the front record while braking
     double brake_u_mm_s_ = 0;  // path speed while braking
     SamplerStatus status_{};
+    // A ring over the first lookahead_records records: entry i of the ring is at
+    // (rooms_head_ + i) % size; the first rooms_valid_ entries are filled.
+    std::vector<PhaseRooms> rooms_;
+    std::size_t rooms_head_ = 0;
+    std::size_t rooms_valid_ = 0;
 };
 
 }  // namespace motion

@@ -1,0 +1,257 @@
+// Realtime cost of one servo period of the motion sampler (Sampler::advance), per program, jerk
+// limit and feed override, with the ring kept full (the sampler looks up to 512 records ahead
+// above 100 %). Each advance() is timed on its own: Google Benchmark's time is the wall-clock
+// mean (manual time), which on a shared machine includes the periods in which the thread was
+// preempted; the counters give this thread's CPU time per period (CLOCK_THREAD_CPUTIME_ID, the
+// clock's own cost measured and taken off), which does not: mean, 99.9th percentile and the
+// largest single period, in ns.
+//
+//   bench_sampler [--benchmark_* options]    the cost table (docs/benchmarks.md)
+//   bench_sampler --digest PROGRAM...        runs each program to its end at 100 %, 120 % and an
+//                                            override toggling between them, jerk unlimited and
+//                                            1e5 mm/s^3; prints a hash of every sample, so two
+//                                            builds can be shown to sample identically; exits 1
+//                                            if a run leaves the axis limits or does not finish.
+#include <benchmark/benchmark.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <ctime>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "motion/planner.hpp"
+#include "motion/sampler.hpp"
+#include "ngc_program.hpp"
+
+namespace {
+
+using namespace motion;
+
+constexpr double kVel_mm_s = 100, kAcc_mm_s2 = 1000, kPeriod_s = 1e-3, kTolerance_mm = 0.01;
+constexpr double kJerkLimited_mm_s3 = 1e5;
+
+PlannerConfig config_for(double jerk_mm_s3) {
+    PlannerConfig cfg;
+    cfg.limits.vel_mm_s.fill(kVel_mm_s);
+    cfg.limits.acc_mm_s2.fill(kAcc_mm_s2);
+    cfg.limits.jerk_mm_s3.fill(jerk_mm_s3);
+    cfg.servo_period_s = kPeriod_s;
+    return cfg;
+}
+
+std::vector<PreparedSegment> plan_all(const PlannerConfig& cfg, const bench::BenchProgram& prog) {
+    Planner planner(cfg, prog.start_mm);
+    std::vector<PreparedSegment> out;
+    PreparedSegment rec;
+    for (const PathSegment& seg : prog.segments) {
+        planner.push(seg);
+        while (planner.pop(rec)) out.push_back(rec);
+    }
+    planner.finish();
+    while (planner.pop(rec)) out.push_back(rec);
+    return out;
+}
+
+// The override for period i: fixed, or stepping between 100 % and 120 % every `toggle` periods
+// (long enough for the rate to get there without a jerk limit: 0.2 / 0.1 per s = 2 s).
+enum class OverrideMode { At100, At120, Toggle };
+constexpr long kTogglePeriods = 3000;
+
+double override_at(OverrideMode m, long period) {
+    switch (m) {
+        case OverrideMode::At100:
+            return 1.0;
+        case OverrideMode::At120:
+            return 1.2;
+        case OverrideMode::Toggle:
+            return (period / kTogglePeriods) % 2 == 0 ? 1.0 : 1.2;
+    }
+    return 1.0;
+}
+
+const char* mode_name(OverrideMode m) {
+    return m == OverrideMode::At100 ? "100" : m == OverrideMode::At120 ? "120" : "toggle";
+}
+
+double thread_cpu_ns() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return ts.tv_sec * 1e9 + ts.tv_nsec;
+}
+
+// The least time two back-to-back readings of the thread CPU clock report (its own cost).
+double cpu_clock_overhead_ns() {
+    double best = 1e9;
+    for (int i = 0; i < 2000; ++i) {
+        const double a = thread_cpu_ns();
+        best = std::min(best, thread_cpu_ns() - a);
+    }
+    return best;
+}
+
+// ---- cost ------------------------------------------------------------------------------------
+
+struct CostCase {
+    std::string program;  // file name in bench/
+    double jerk_mm_s3;
+    OverrideMode mode;
+};
+
+// Endless supply: the program's records over and over (program_end cleared, so the sampler
+// never stops; the jump from the last record's end to the first's start does not matter for
+// the cost).
+class Feeder {
+  public:
+    explicit Feeder(std::vector<PreparedSegment> recs) : recs_(std::move(recs)) {
+        for (auto& r : recs_) r.program_end = false;
+    }
+    void top_up(SpscRing<PreparedSegment>& ring) {
+        while (ring.try_push(recs_[next_])) next_ = (next_ + 1) % recs_.size();
+    }
+
+  private:
+    std::vector<PreparedSegment> recs_;
+    std::size_t next_ = 0;
+};
+
+void bm_period(benchmark::State& state, const CostCase& c) {
+    const PlannerConfig cfg = config_for(c.jerk_mm_s3);
+    const bench::BenchProgram prog =
+        bench::read_program(std::string(MOTION_BENCH_DIR) + "/" + c.program, kTolerance_mm);
+    Feeder feeder(plan_all(cfg, prog));
+    SpscRing<PreparedSegment> ring(1024);
+    feeder.top_up(ring);
+    Sampler sampler(sampler_config(cfg), ring, prog.start_mm);
+    const double overhead_ns = cpu_clock_overhead_ns();
+    std::vector<double> all_ns, rising_ns;
+    all_ns.reserve(static_cast<std::size_t>(state.max_iterations));
+    long period = 0;
+    for (auto _ : state) {
+        feeder.top_up(ring);
+        sampler.set_feed_override(override_at(c.mode, period));
+        const double rate_before = sampler.status().rate;
+        const auto t0 = std::chrono::steady_clock::now();
+        const double c0 = thread_cpu_ns();
+        MotionSample ms = sampler.advance(kPeriod_s);
+        const double c1 = thread_cpu_ns();
+        const auto t1 = std::chrono::steady_clock::now();
+        benchmark::DoNotOptimize(ms);
+        state.SetIterationTime(std::chrono::duration<double>(t1 - t0).count());
+        const double ns = std::max(0.0, c1 - c0 - overhead_ns);
+        all_ns.push_back(ns);
+        if (sampler.status().rate > rate_before) rising_ns.push_back(ns);
+        ++period;
+    }
+    auto report = [&](std::vector<double>& v, const std::string& prefix) {
+        if (v.empty()) return;
+        double sum = 0;
+        for (double x : v) sum += x;
+        std::sort(v.begin(), v.end());
+        const std::size_t i999 = std::min(v.size() - 1, v.size() * 999 / 1000);
+        state.counters[prefix + "cpu_mean_ns"] = sum / static_cast<double>(v.size());
+        state.counters[prefix + "cpu_p999_ns"] = v[i999];
+        state.counters[prefix + "cpu_max_ns"] = v.back();
+    };
+    report(all_ns, "");
+    if (c.mode == OverrideMode::Toggle) {
+        state.counters["rising_periods"] = static_cast<double>(rising_ns.size());
+        report(rising_ns, "rise_");
+    }
+}
+
+void register_cost_cases() {
+    for (const char* program : {"surface_3d.ngc", "tangent_arcs.ngc"})
+        for (double jerk : {0.0, kJerkLimited_mm_s3})
+            for (OverrideMode mode :
+                 {OverrideMode::At100, OverrideMode::At120, OverrideMode::Toggle}) {
+                const std::string name = fmt::format("period/{}/jerk:{:g}/override:{}", program,
+                                                     jerk, mode_name(mode));
+                benchmark::RegisterBenchmark(name.c_str(), bm_period,
+                                             CostCase{program, jerk, mode})
+                    ->UseManualTime()
+                    ->Iterations(4 * kTogglePeriods)
+                    ->Unit(benchmark::kMicrosecond);
+            }
+}
+
+// ---- digest ----------------------------------------------------------------------------------
+
+struct Fnv1a {
+    std::uint64_t h = 1469598103934665603ull;
+    void add(const void* p, std::size_t n) {
+        const auto* b = static_cast<const unsigned char*>(p);
+        for (std::size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
+    }
+    void add(const AxisArray& a) { add(a.data(), sizeof(double) * a.size()); }
+};
+
+// Plays the program to its end; false if it left the limits or did not finish.
+bool digest_run(const std::string& path, const bench::BenchProgram& prog, double jerk,
+                OverrideMode mode) {
+    const PlannerConfig cfg = config_for(jerk);
+    std::vector<PreparedSegment> recs = plan_all(cfg, prog);
+    SpscRing<PreparedSegment> ring(recs.size() + 1);
+    for (const auto& r : recs) ring.try_push(r);
+    Sampler sampler(sampler_config(cfg), ring, prog.start_mm);
+    Fnv1a hash;
+    double max_v = 0, max_a = 0;
+    long period = 0;
+    constexpr long kMaxPeriods = 10'000'000;
+    do {
+        sampler.set_feed_override(override_at(mode, period));
+        const MotionSample ms = sampler.advance(kPeriod_s);
+        hash.add(ms.pos_mm);
+        hash.add(ms.vel_mm_s);
+        hash.add(ms.acc_mm_s2);
+        hash.add(ms.jerk_mm_s3);
+        const double rate = sampler.status().rate;
+        hash.add(&rate, sizeof rate);
+        for (int k = 0; k < kAxes; ++k) {
+            max_v = std::max(max_v, std::fabs(ms.vel_mm_s[k]));
+            max_a = std::max(max_a, std::fabs(ms.acc_mm_s2[k]));
+        }
+        ++period;
+    } while (!sampler.status().done && period < kMaxPeriods);
+    const bool ok = sampler.status().done && max_v <= kVel_mm_s * (1 + 1e-9) &&
+                    max_a <= kAcc_mm_s2 * (1 + 1e-6);
+    fmt::print("{} jerk {:g} override {}: {} periods, max |v| {:.4f}, max |a| {:.3f}, "
+               "digest {:016x}{}\n",
+               path, jerk, mode_name(mode), period, max_v, max_a, hash.h,
+               ok ? "" : "  <-- FAILED (limits or end)");
+    return ok;
+}
+
+int digest_main(int argc, char** argv) {
+    bool ok = true;
+    for (int i = 2; i < argc; ++i) {
+        const bench::BenchProgram prog = bench::read_program(argv[i], kTolerance_mm);
+        for (double jerk : {0.0, kJerkLimited_mm_s3})
+            for (OverrideMode mode :
+                 {OverrideMode::At100, OverrideMode::At120, OverrideMode::Toggle})
+                ok = digest_run(argv[i], prog, jerk, mode) && ok;
+    }
+    return ok ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    try {
+        if (argc >= 2 && std::strcmp(argv[1], "--digest") == 0) return digest_main(argc, argv);
+        benchmark::Initialize(&argc, argv);
+        if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+        register_cost_cases();
+        benchmark::RunSpecifiedBenchmarks();
+        benchmark::Shutdown();
+        return 0;
+    } catch (const std::exception& e) {
+        fmt::print(stderr, "bench_sampler: {}\n", e.what());
+        return 1;
+    }
+}
