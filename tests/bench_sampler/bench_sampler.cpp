@@ -170,10 +170,9 @@ void register_cost_cases() {
         for (double jerk : {0.0, kJerkLimited_mm_s3})
             for (OverrideMode mode :
                  {OverrideMode::At100, OverrideMode::At120, OverrideMode::Toggle}) {
-                const std::string name = fmt::format("period/{}/jerk:{:g}/override:{}", program,
-                                                     jerk, mode_name(mode));
-                benchmark::RegisterBenchmark(name.c_str(), bm_period,
-                                             CostCase{program, jerk, mode})
+                const std::string name =
+                    fmt::format("period/{}/jerk:{:g}/override:{}", program, jerk, mode_name(mode));
+                benchmark::RegisterBenchmark(name.c_str(), bm_period, CostCase{program, jerk, mode})
                     ->UseManualTime()
                     ->Iterations(4 * kTogglePeriods)
                     ->Unit(benchmark::kMicrosecond);
@@ -220,10 +219,11 @@ bool digest_run(const std::string& path, const bench::BenchProgram& prog, double
     } while (!sampler.status().done && period < kMaxPeriods);
     const bool ok = sampler.status().done && max_v <= kVel_mm_s * (1 + 1e-9) &&
                     max_a <= kAcc_mm_s2 * (1 + 1e-6);
-    fmt::print("{} jerk {:g} override {}: {} periods, max |v| {:.4f}, max |a| {:.3f}, "
-               "digest {:016x}{}\n",
-               path, jerk, mode_name(mode), period, max_v, max_a, hash.h,
-               ok ? "" : "  <-- FAILED (limits or end)");
+    fmt::print(
+        "{} jerk {:g} override {}: {} periods, max |v| {:.4f}, max |a| {:.3f}, "
+        "digest {:016x}{}\n",
+        path, jerk, mode_name(mode), period, max_v, max_a, hash.h,
+        ok ? "" : "  <-- FAILED (limits or end)");
     return ok;
 }
 

@@ -43,9 +43,9 @@ namespace motion {
 
 struct SamplerConfig {
     AxisLimits limits;
-    double override_reserve = 0.1;        // must equal the planner's
-    double max_rate = 1.2;                // must equal the planner's
-    double junction_share = 0.1;          // must equal the planner's
+    double override_reserve = 0.1;  // must equal the planner's
+    double max_rate = 1.2;          // must equal the planner's
+    double junction_share = 0.1;    // must equal the planner's
     // Most records scanned for rate caps per period; also the size of the per-record room cache
     // the constructor allocates (jerk unlimited: each record's rooms are computed once).
     std::size_t lookahead_records = 512;
