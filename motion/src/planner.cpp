@@ -116,6 +116,7 @@ void Planner::push(const PathSegment& seg) {
     next.tolerance_mm = seg.tolerance_mm;
     next.exact_stop = seg.exact_stop;
     next.line = seg.line;
+    next.move_id = seg.move_id;
     last_end_ = seg.end_mm;
     if (have_pending_) close_piece(pending_, &next);
     pending_ = next;
@@ -278,24 +279,23 @@ void Planner::close_piece(Piece& p, Piece* next) {
     bool rough = p.rough_start || jn.rough;
     Element e = trimmed(p.geom, p.trim_start_mm, jn.blend_l_mm);
     // Only a line blended at both ends can vanish, and its junctions are smooth.
-    if (e.length_mm > kMinLength_mm) add_item(e, p.feed_mm_s, jn.cap_mm_s, rough, p.line);
+    if (e.length_mm > kMinLength_mm) add_item(e, p.feed_mm_s, jn.cap_mm_s, rough, p);
     if (!next) return;
     double f1 = p.feed_mm_s, f2 = next->feed_mm_s;
     double feed = f1 > 0 && f2 > 0 ? std::min(f1, f2) : std::max(f1, f2);
     switch (jn.blend) {
         case Blend::Curve:
-            add_item(jn.curve, feed, jn.curve_end_cap_mm_s, jn.rough || jn.curve_end_rough,
-                     next->line);
+            add_item(jn.curve, feed, jn.curve_end_cap_mm_s, jn.rough || jn.curve_end_rough, *next);
             next->trim_start_mm = jn.blend_l_mm;
             next->rough_start = jn.curve_end_rough;
             return;
         case Blend::Parabola:
             add_item(make_parabola(p.geom.end, p.geom.a, next->geom.a, jn.blend_l_mm), feed, kInf,
-                     false, next->line);
+                     false, *next);
             break;
         case Blend::Quartic:
             add_item(make_blend(p.geom.end, p.geom.a, next->geom.a, jn.blend_l_mm), feed, kInf,
-                     false, next->line);
+                     false, *next);
             break;
         case Blend::None:
             break;
@@ -305,14 +305,15 @@ void Planner::close_piece(Piece& p, Piece* next) {
 }
 
 void Planner::add_item(const Element& e, double feed, double end_cap, bool rough,
-                       std::int32_t line) {
+                       const Piece& owner) {
     Item it;
     it.geom = e;
     double cut = reserve_ + (rough ? cfg_.junction_share : 0);
     it.lim = element_limits(e, bounds(e), cfg_.limits, feed, {1 - cut, 1 - cut});
     it.end_cap_mm_s = end_cap;
     it.rough = rough;
-    it.line = line;
+    it.line = owner.line;
+    it.move_id = owner.move_id;
     it.rapid = feed <= 0;  // blends between two rapids are rapid too
     items_.push_back(it);
 }
@@ -518,6 +519,7 @@ void Planner::emit(const Item& it, const Profile1D& prof) {
                                                     rate_share, cfg_.max_rate);
     }
     rec.line = it.line;
+    rec.move_id = it.move_id;
     rec.rapid = it.rapid;
     rec.seq = seq_++;
 }

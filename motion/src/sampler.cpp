@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
+
+#include "motion/jerk_stop.hpp"
 
 namespace motion {
 namespace {
@@ -89,6 +92,28 @@ Sampler::Sampler(const SamplerConfig& cfg, SpscRing<PreparedSegment>& ring, cons
                                 [](double j) { return j > 0; });
 }
 
+// The front record's outputs fall due once: when the path first moves in it, or when it is
+// left (also when it was crossed within one period).
+void Sampler::enter_front() noexcept {
+    if (front_entered_ || ring_.size() == 0) return;
+    front_entered_ = true;
+    const PreparedSegment& rec = ring_.peek(0);
+    if ((rec.dout_set | rec.dout_clear) == 0) return;
+    outputs_due_.set = (outputs_due_.set & ~rec.dout_clear) | rec.dout_set;
+    outputs_due_.clear = (outputs_due_.clear & ~rec.dout_set) | rec.dout_clear;
+}
+
+void Sampler::pop_front() noexcept {
+    enter_front();
+    drop_front();
+}
+
+Sampler::SyncOutputs Sampler::take_sync_outputs() noexcept {
+    const SyncOutputs due = outputs_due_;
+    outputs_due_ = {};
+    return due;
+}
+
 void Sampler::set_feed_override(double scale) noexcept {
     override_ = std::clamp(std::isfinite(scale) ? scale : 0.0, 0.0, cfg_.max_rate);
 }
@@ -116,6 +141,8 @@ void Sampler::clear_abort() noexcept {
     brake_ = Brake::None;
     action_done_ = false;
     block_released_ = false;
+    front_entered_ = false;
+    jog_.clear();
     status_.aborted = false;
     tau_ = 0;
 }
@@ -389,10 +416,11 @@ void Sampler::warm_rooms(std::size_t count) noexcept {
     if (upto > 0 && upto > rooms_valid_) rooms_of(upto - 1);
 }
 
-void Sampler::pop_front() noexcept {
+void Sampler::drop_front() noexcept {
     ring_.pop();
     rooms_head_ = (rooms_head_ + 1) % rooms_.size();
     if (rooms_valid_ > 0) --rooms_valid_;
+    front_entered_ = false;
 }
 
 // Without a jerk limit r' may change from one period to the next (integrate_rate_free), so this
@@ -514,6 +542,23 @@ void Sampler::start_brake(Brake kind) noexcept {
     brake_ = kind;
     brake_s_mm_ = tau_ >= cur.profile.duration_s ? cur.geom.length_mm : ps.s_mm;
     brake_u_mm_s_ = u;
+    brake_a_mm_s2_ = path_accel(ps);
+}
+
+// The path acceleration now: the planned one time-scaled by the rate (d/dt of v r).
+double Sampler::path_accel(const PathState& ps) const noexcept {
+    return ps.a_mm_s2 * r_ * r_ + ps.v_mm_s * rd_;
+}
+
+// The tangential jerk that keeps every axis within its jerk limit on this record (the terms of
+// the curvature left out); infinite when no axis has a jerk limit.
+double Sampler::path_jerk_limit(const PreparedSegment& rec) const noexcept {
+    const ElementBounds b = bounds(rec.geom);
+    double j = kInf;
+    for (int k = 0; k < kAxes; ++k)
+        if (b.g1[k] > 1e-12 && cfg_.limits.jerk_mm_s3[k] > 0)
+            j = std::min(j, cfg_.limits.jerk_mm_s3[k] / b.g1[k]);
+    return j;
 }
 
 // Single block: brake when the rest of the block is just long enough to stop in.
@@ -528,25 +573,56 @@ void Sampler::check_block_end_brake() noexcept {
     bool planned_stop = false;
     const double d = block_remaining(s, &planned_stop);
     if (planned_stop) return;  // the plan ends the block at rest itself, within the jerk limit
-    if (u * u >= 2 * kBlockBrakeShare * decel_limit(cur, u) * d) start_brake(Brake::BlockEnd);
+    const double decel = kBlockBrakeShare * decel_limit(cur, u);
+    const double jerk = kBlockBrakeShare * path_jerk_limit(cur);
+    const double need_mm = std::isfinite(jerk)
+                               ? jerk_stop_distance({u, path_accel(ps)}, decel, jerk)
+                               : u * u / (2 * decel);
+    if (need_mm >= d) start_brake(Brake::BlockEnd);
 }
 
-// One period of a braking stop: u falls at a constant deceleration (the limit for a fault, the
-// one that lands on the block's end for single block), the position is walked along the records.
+// Single block's stop with a jerk limit: re-solved every period for the peak deceleration that
+// lands on the block's end (jerk_stop.hpp). False when none within the limits does (the stop
+// started too late, or the machine has no jerk limit): the caller brakes at a constant rate.
+bool Sampler::jerk_brake(const PreparedSegment& cur, double left_mm, double dt,
+                         JerkStopStep& step) const noexcept {
+    const double jerk = path_jerk_limit(cur);
+    if (!std::isfinite(jerk)) return false;
+    const JerkStopState now{brake_u_mm_s_, brake_a_mm_s2_};
+    const std::optional<double> decel =
+        jerk_stop_decel_for(now, left_mm, decel_limit(cur, brake_u_mm_s_), jerk);
+    if (!decel) return false;
+    step = jerk_stop_step(now, *decel, jerk, dt);
+    return true;
+}
+
+// One period of a braking stop, the position walked along the records. A fault brakes at the
+// constant deceleration limit, jerk ignored. Single block lands on the block's end: with a jerk
+// limit along a jerk-limited stop (jerk_brake), else at the constant deceleration that lands.
 MotionSample Sampler::brake_step(double dt) noexcept {
     const PreparedSegment* cur = &ring_.peek(0);
     const double u = brake_u_mm_s_;
-    double decel = 0, left = kInf;
-    if (brake_ == Brake::BlockEnd) {
-        left = block_remaining(brake_s_mm_, nullptr);
-        decel = left > 0 ? u * u / (2 * left) : kInf;
+    double decel = 0, left = kInf, u1 = 0, ds = 0, a1 = 0, jerk = 0;
+    bool stopped = false;
+    JerkStopStep js;
+    if (brake_ == Brake::BlockEnd) left = block_remaining(brake_s_mm_, nullptr);
+    if (brake_ == Brake::BlockEnd && left > 0 && jerk_brake(*cur, left, dt, js)) {
+        u1 = js.next.v_mm_s;
+        a1 = js.next.a_mm_s2;
+        ds = js.ds_mm;
+        jerk = js.jerk_mm_s3;
+        stopped = js.at_rest;
     } else {
-        decel = decel_limit(*cur, u);
+        if (brake_ == Brake::BlockEnd)
+            decel = left > 0 ? u * u / (2 * left) : kInf;
+        else
+            decel = decel_limit(*cur, u);
+        const double t_stop = decel > 0 ? u / decel : kInf;
+        u1 = t_stop <= dt ? 0.0 : u - decel * dt;
+        ds = (u + u1) / 2 * std::min(dt, t_stop);  // exact for a constant deceleration
+        a1 = -decel;
+        stopped = u1 <= 0;
     }
-    const double t_stop = decel > 0 ? u / decel : kInf;
-    double u1 = t_stop <= dt ? 0.0 : u - decel * dt;
-    double ds = (u + u1) / 2 * std::min(dt, t_stop);  // exact for a constant deceleration
-    bool stopped = u1 <= 0;
     if (brake_ == Brake::BlockEnd && (stopped || ds >= left)) {
         land_at_block_end();
         cur = &ring_.peek(0);
@@ -568,13 +644,15 @@ MotionSample Sampler::brake_step(double dt) noexcept {
         brake_s_mm_ = s;
     }
     brake_u_mm_s_ = u1;
+    brake_a_mm_s2_ = stopped ? 0.0 : a1;
+    if (brake_s_mm_ > 0) enter_front();
     CurvePoint cp;
     evaluate(cur->geom, brake_s_mm_, cp);
     for (int k = 0; k < kAxes; ++k) {
         last_.pos_mm[k] = cp.p[k];
         last_.vel_mm_s[k] = u1 * cp.d1[k];
-        last_.acc_mm_s2[k] = stopped ? 0.0 : -decel * cp.d1[k] + u1 * u1 * cp.d2[k];
-        last_.jerk_mm_s3[k] = 0;
+        last_.acc_mm_s2[k] = stopped ? 0.0 : a1 * cp.d1[k] + u1 * u1 * cp.d2[k];
+        last_.jerk_mm_s3[k] = stopped ? 0.0 : jerk * cp.d1[k];
     }
     last_.line = cur->line;
     status_.moving = !stopped;
@@ -595,11 +673,54 @@ MotionSample Sampler::brake_step(double dt) noexcept {
     return last_;
 }
 
+bool Sampler::front_is_probe() const noexcept {
+    return ring_.size() > 0 && ring_.peek(0).action.kind == ActionKind::ConditionalMove;
+}
+
+// The front record is a conditional move: the jog moves the axes until its inputs come (or
+// its travel ends), the owner takes the result and reports the action done; then the record
+// stands at the jog's end point until the records planned from there arrive.
+MotionSample Sampler::probe_step(double dt) noexcept {
+    const PreparedSegment& cur = ring_.peek(0);
+    if (!jog_.active()) jog_.start(sample(cur, 0).pos_mm, cur.probe, cfg_.limits);
+    if (abort_) jog_.stop_now();
+    const double scale = abort_ || hold_ ? 0.0 : cur.action.flag ? 1.0 : override_;
+    const AxisArray before = jog_.vel_mm_s();
+    jog_.step(dt, inputs_, scale);
+    last_.pos_mm = jog_.pos_mm();
+    last_.vel_mm_s = jog_.vel_mm_s();
+    for (int k = 0; k < kAxes; ++k) last_.acc_mm_s2[k] = (last_.vel_mm_s[k] - before[k]) / dt;
+    last_.jerk_mm_s3 = {};
+    last_.line = cur.line;
+    const bool finished = jog_.finished();
+    const bool still =
+        std::all_of(last_.vel_mm_s.begin(), last_.vel_mm_s.end(), [](double v) { return v == 0; });
+    status_ = {};
+    status_.moving = !still;
+    status_.action_pending = !action_done_;
+    // Done and nothing after it yet: at rest here like at a program end (the record is one).
+    status_.done = finished && action_done_ && ring_.size() == 1;
+    status_.held = hold_ && still && !finished;
+    status_.aborted = abort_ && finished;
+    status_.rate = r_;
+    return last_;
+}
+
 MotionSample Sampler::advance(double dt) noexcept {
     if (fault_ && !status_.aborted && brake_ != Brake::Fault) start_brake(Brake::Fault);
     if (brake_ != Brake::None) return brake_step(dt);
-    if (status_.aborted) {  // discard until clear_abort()
-        while (ring_.size() > 0) pop_front();
+    if (!status_.aborted && front_is_probe()) {
+        const bool leave =
+            jog_.active() && jog_.finished() && action_done_ && ring_.size() > 1 && !abort_;
+        if (!leave) return probe_step(dt);
+        pop_front();  // the records planned from the jog's end point follow
+        jog_.clear();
+        action_done_ = false;
+        tau_ = 0;
+    }
+    if (status_.aborted) {  // discard until clear_abort(); their outputs never fall due
+        while (ring_.size() > 0) drop_front();
+        jog_.clear();
         last_.vel_mm_s = {};
         last_.acc_mm_s2 = {};
         last_.jerk_mm_s3 = {};
@@ -648,6 +769,7 @@ MotionSample Sampler::advance(double dt) noexcept {
         last_.jerk_mm_s3[k] = j * r_ * r_ * r_ + 3 * a * r_ * rd_ + v * rdd_;
     }
     last_.line = planned.line;
+    if (tau_ > 0 && !is_action(cur)) enter_front();
     status_.action_pending = is_action(cur) && !action_done_;
     status_.block_paused =
         !status_.action_pending && tau_ >= cur.profile.duration_s && pauses_at_block_end(cur);

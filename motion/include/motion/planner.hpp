@@ -76,6 +76,7 @@ class Planner {
         double tolerance_mm;
         bool exact_stop;
         std::int32_t line;
+        std::uint32_t move_id;
         double trim_start_mm = 0;
         bool rough_start = false;  // the junction at its start is not smooth
     };
@@ -86,6 +87,7 @@ class Planner {
         bool rough;           // next to a junction that is not smooth
         bool rapid;
         std::int32_t line;
+        std::uint32_t move_id;
     };
     // Consecutive elements planned as one profile (jerk-limited mode; otherwise one each).
     struct Group {
@@ -115,7 +117,7 @@ class Planner {
     // junction share of one period's jerk (infinite without a jerk limit).
     double curvature_step_cap(const AxisArray& d2_before, const AxisArray& d2_after) const;
     void close_piece(Piece& p, Piece* next);
-    void add_item(const Element& e, double feed, double end_cap, bool rough, std::int32_t line);
+    void add_item(const Element& e, double feed, double end_cap, bool rough, const Piece& owner);
     std::size_t plan_and_emit(bool all);  // returns how many records it emitted
     bool can_join(const Group& g, const Item& it) const;
     void build_groups();

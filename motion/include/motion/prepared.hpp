@@ -27,6 +27,11 @@ enum class ActionKind : std::uint8_t {
     Pause,          // M00
     OptionalPause,  // M01: pauses only while the optional-stop switch is on
     ToolOffset,     // number = tool length offset in Z, mm (G43/G49): motion.tooloffset.z
+
+    // Before the first feed move after a spindle start or speed change: spindle.0.at-speed.
+    SpindleAtSpeed,
+    // G904: the sampler runs PreparedSegment::probe; flag = feed override fixed at 100 % (G903).
+    ConditionalMove,
 };
 
 struct Action {
@@ -34,6 +39,15 @@ struct Action {
     bool flag = false;
     std::int32_t value = 0;
     double number = 0;
+};
+
+// One axis of a conditional move (G904, probe_jog.hpp). Axes X Y Z only.
+inline constexpr int kProbeAxes = 3;
+struct ProbeAxis {
+    std::int32_t input = -1;  // motion.digital-in index; < 0: the axis does not take part
+    bool level = false;       // the input level that stops the axis
+    double speed_mm_s = 0;    // signed: the direction of travel
+    double travel_mm = 0;     // farthest it may go (the maximum travel or the soft limit)
 };
 
 struct PreparedSegment {
@@ -46,6 +60,14 @@ struct PreparedSegment {
     bool rapid = false;        // a traverse (G0): the rapid override applies, not the feed override
     bool program_end = false;  // the last record before the planner was told finish(): ends at rest
     Action action;             // kind != None: a standing record of zero duration (see Action)
+    // Digital outputs synchronised with motion (M901; LinuxCNC's M62/M63): bit n set/cleared
+    // changes motion.digital-out-n in the period the sampler starts following this record.
+    std::uint64_t dout_set = 0;
+    std::uint64_t dout_clear = 0;
+    // The planner copies PathSegment::move_id to every record made from that segment (the
+    // blend into it included), so the feeder can find where a move begins.
+    std::uint32_t move_id = 0;
+    std::array<ProbeAxis, kProbeAxes> probe{};  // ActionKind::ConditionalMove only
 };
 static_assert(std::is_trivially_copyable_v<PreparedSegment>,
               "PreparedSegment must be copyable through a lock-free ring");

@@ -18,13 +18,18 @@
 // keeps only a small fixed reserve (PlannerConfig::override_reserve_no_jerk), and a rate change
 // waits, where the plan uses nearly all of an axis's acceleration, until the plan leaves room.
 //
-// Two stops do not scale time but drive the path speed u directly, ignoring the jerk limit:
+// Two stops do not scale time but drive the path speed u directly:
 // - fault_stop() (a drive fault, a limit switch, an e-stop) decelerates along the path at the
-//   full acceleration the axes allow (a line at a: stops within u^2 / 2a), then discards the
-//   queue like abort();
-// - single block: when the rest of the current block is just long enough to stop in at 80 % of
-//   that deceleration, u falls at the constant rate that lands exactly on the block's end.
-// Action records (prepared.hpp) are stood on until the owner calls action_done().
+//   full acceleration the axes allow, ignoring the jerk limit (a line at a: stops within
+//   u^2 / 2a), then discards the queue like abort();
+// - single block: when the rest of the current block is just long enough for a stop at 80 % of
+//   the deceleration and jerk limits, u follows the jerk-limited stop (jerk_stop.hpp) that lands
+//   exactly on the block's end, re-solved every period. Without a jerk limit (or if the stop
+//   started too late for one) it falls at the constant rate that lands there.
+// Action records (prepared.hpp) are stood on until the owner calls action_done(); on a
+// conditional move's record (G904) the sampler itself moves the axes meanwhile (ProbeJog). Digital
+// outputs synchronised with motion ride on motion records (dout_set / dout_clear) and fall due
+// in the period the sampler starts following their record; take_sync_outputs() collects them.
 //
 // Everything on this class is realtime-safe (noexcept, no allocation, bounded time) except
 // the constructor. One thread drives advance(); the controls may be called from the same thread.
@@ -32,10 +37,13 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
+#include "motion/jerk_stop.hpp"
 #include "motion/planner.hpp"
 #include "motion/prepared.hpp"
+#include "motion/probe_jog.hpp"
 #include "motion/spsc_ring.hpp"
 #include "motion/types.hpp"
 
@@ -92,6 +100,22 @@ class Sampler {
     // The owner has carried out the pending action: motion goes on with the next record.
     void action_done() noexcept;
 
+    // The synchronised outputs of the records entered since the last call, in program order
+    // (a later record's set or clear wins), then forgets them. Call once per period after
+    // advance().
+    struct SyncOutputs {
+        std::uint64_t set = 0;
+        std::uint64_t clear = 0;
+    };
+    SyncOutputs take_sync_outputs() noexcept;
+
+    // The digital inputs (bit n = motion.digital-in-n) a conditional move watches; set them
+    // every period before advance().
+    void set_inputs(std::uint64_t bits) noexcept { inputs_ = bits; }
+    // The conditional move (G904) of the action record stood on: it runs while its action is
+    // pending; when finished() the owner reads the result and calls action_done().
+    const ProbeJog& probe_jog() const noexcept { return jog_; }
+
     // Advances wall time by dt_s and returns the commanded motion at the new time.
     MotionSample advance(double dt_s) noexcept;
 
@@ -110,8 +134,11 @@ class Sampler {
     double room_rate(double from, double to, double r_hi) const noexcept;
     RateLimits room_limits(const RateLimits& base, double target, double dt) const noexcept;
     void consume_finished_records() noexcept;
-    // Every pop of the ring goes through here, so the room cache stays aligned with the ring.
+    // Every pop of the ring goes through here, so the room cache stays aligned with the ring;
+    // pop_front() also makes the record's synchronised outputs due, drop_front() (an abort's
+    // discard) does not.
     void pop_front() noexcept;
+    void drop_front() noexcept;
     // phase_room() of each phase of one record at the highest rate (what rate_cap_free() needs),
     // computed once per record instead of once per period: records never change in the ring.
     struct PhaseRooms {
@@ -127,7 +154,14 @@ class Sampler {
     double block_remaining(double s_mm, bool* planned_stop) const noexcept;
     void land_at_block_end() noexcept;
     MotionSample brake_step(double dt) noexcept;
+    double path_accel(const PathState& ps) const noexcept;
+    double path_jerk_limit(const PreparedSegment& rec) const noexcept;
+    bool jerk_brake(const PreparedSegment& cur, double left_mm, double dt,
+                    JerkStopStep& step) const noexcept;
     void check_block_end_brake() noexcept;
+    bool front_is_probe() const noexcept;
+    MotionSample probe_step(double dt) noexcept;
+    void enter_front() noexcept;
 
     SamplerConfig cfg_;
     RateLimits rl_;           // fixed limits from the reserve
@@ -148,8 +182,13 @@ class Sampler {
     bool block_released_ = false;  // resume_block() given at the current block end
     bool action_done_ = false;     // for the action record at the front
     Brake brake_ = Brake::None;
-    double brake_s_mm_ = 0;    // position within the front record while braking
-    double brake_u_mm_s_ = 0;  // path speed while braking
+    double brake_s_mm_ = 0;       // position within the front record while braking
+    double brake_u_mm_s_ = 0;     // path speed while braking
+    double brake_a_mm_s2_ = 0;    // path acceleration while braking (single block's jerk stop)
+    bool front_entered_ = false;  // the front record's synchronised outputs are due already
+    SyncOutputs outputs_due_{};
+    ProbeJog jog_;
+    std::uint64_t inputs_ = 0;
     SamplerStatus status_{};
     // A ring over the first lookahead_records records: entry i of the ring is at
     // (rooms_head_ + i) % size; the first rooms_valid_ entries are filled.

@@ -42,7 +42,8 @@ struct PathSegment {
     // Blend tolerance for the corner at this move's end (G64 P). 0 = exact path (G61): corners
     // that are not tangent are stopped at, never rounded.
     double tolerance_mm = 0;
-    std::int32_t line = 0;  // source line tag, reported back while the move runs
+    std::int32_t line = 0;      // source line tag, reported back while the move runs
+    std::uint32_t move_id = 0;  // opaque tag copied to the records made from this segment
 };
 
 // A segment the planner cannot follow: names the source line and what is wrong.
