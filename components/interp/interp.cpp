@@ -19,6 +19,7 @@
 namespace {
 
 constexpr long kDefaultDepth = 1024;
+constexpr long kMaxDio = 64;  // NcStudio's ports 0..63, as motion's num_dio
 
 class Interp : public hal::Instance, public interpcomp::MachineLink {
   public:
@@ -55,6 +56,10 @@ class Interp : public hal::Instance, public interpcomp::MachineLink {
     }
     std::uint32_t barriers_reached() const noexcept override { return motion_sync_.get(); }
     double machine_pos_mm(int axis) const noexcept override { return machine_pos_[axis]->get(); }
+    std::uint64_t input_bits() const noexcept override { return bits(digital_in_); }
+    std::uint64_t output_bits() const noexcept override { return bits(digital_out_); }
+    double spindle_rpm() const noexcept override { return spindle_speed_in_.get(); }
+    bool probe_tripped() const noexcept override { return probe_tripped_.get(); }
     bool abort_requested() const noexcept override { return abort_.get(); }
     void on_progress() noexcept override {
         program_line_ = runner_.line();
@@ -66,6 +71,20 @@ class Interp : public hal::Instance, public interpcomp::MachineLink {
 
   private:
     bool default_named() const { return name() == fmt::format("interp.{}", index()); }
+
+    static std::uint64_t bits(const hal::Array<hal::In<bool>>& pins) noexcept {
+        std::uint64_t b = 0;
+        for (std::size_t n = 0; n < pins.size(); ++n)
+            if (pins[n].get()) b |= std::uint64_t{1} << n;
+        return b;
+    }
+
+    std::size_t read_num_dio() const {
+        const long n = arg_int("num_dio", 4);
+        if (n < 1 || n > kMaxDio)
+            throw hal::Error(fmt::format("num_dio={}: must be 1 to {}", n, kMaxDio));
+        return static_cast<std::size_t>(n);
+    }
 
     // interp.machine-pos-x … -c: the interpreter's machine axes X Y Z A B C.
     std::array<std::unique_ptr<hal::In<double>>, interp::kMachineAxes> make_machine_pos() {
@@ -120,6 +139,14 @@ class Interp : public hal::Instance, public interpcomp::MachineLink {
     hal::In<std::uint32_t> motion_sync_{this, pin("motion-sync")};
     std::array<std::unique_ptr<hal::In<double>>, interp::kMachineAxes> machine_pos_ =
         make_machine_pos();
+    // Live machine state for #IMPORTMAP / #OUTPORTMAP / #SSINPORTn / #SSSPINDLEREV and G904
+    // (net from motion.digital-in-NN, motion.digital-out-NN, the spindle's speed feedback and
+    // motion.probe-tripped).
+    std::size_t num_dio_ = read_num_dio();
+    hal::Array<hal::In<bool>> digital_in_{this, pin("digital-in-{:02}"), num_dio_};
+    hal::Array<hal::In<bool>> digital_out_{this, pin("digital-out-{:02}"), num_dio_};
+    hal::In<double> spindle_speed_in_{this, pin("spindle-speed-in")};
+    hal::In<bool> probe_tripped_{this, pin("probe-tripped")};
     hal::Stream stream_;
     interpcomp::ProgramRunner runner_;
     bool reported_ = false;
@@ -128,4 +155,4 @@ class Interp : public hal::Instance, public interpcomp::MachineLink {
 }  // namespace
 
 HAL_COMPONENT(interp, Interp, "G-code interpreter writing canonical commands into a HAL stream",
-              "program", "dialect", "stream", "depth", "standalone")
+              "program", "dialect", "stream", "depth", "standalone", "num_dio")

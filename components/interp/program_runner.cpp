@@ -26,19 +26,23 @@ class ProgramRunner::Sink final : public interp::CanonSink {
   public:
     explicit Sink(ProgramRunner& runner) : runner_(runner) {}
     void emit(const interp::Canon& c) override {
-        if (std::holds_alternative<interp::canon::Sync>(c.cmd))
+        if (std::holds_alternative<interp::canon::Sync>(c.cmd)) {
             runner_.sync(c.loc);
-        else
-            runner_.send(c);
+            return;
+        }
+        runner_.send(c);
+        if (const auto* cm = std::get_if<interp::canon::ConditionalMove>(&c.cmd))
+            runner_.adopt_probe_result(c.loc, *cm);
     }
 
   private:
     ProgramRunner& runner_;
 };
 
-// What named parameters read. Positions are the machine's live ones after a barrier (motion
-// has followed everything sent and stands in position); modal state, settings, inputs and
-// outputs come from the executor's model.
+// What named parameters read. Positions, inputs, outputs and the spindle speed are the
+// machine's live ones after a barrier (motion has followed everything sent and stands in
+// position); modal state and settings come from the executor's model. Standalone, everything
+// comes from the model.
 class ProgramRunner::LiveMachine final : public interp::MachineQuery {
   public:
     LiveMachine(ProgramRunner& runner, interp::Executor& exec) : runner_(runner), exec_(exec) {}
@@ -53,9 +57,21 @@ class ProgramRunner::LiveMachine final : public interp::MachineQuery {
         const double offset_mm = exec_.machine_pos_mm(axis) - exec_.work_pos_mm(axis);
         return machine_pos_mm(axis) - offset_mm;
     }
-    std::uint64_t input_bits() override { return exec_.input_bits(); }
-    std::uint64_t output_bits() override { return exec_.output_bits(); }
-    double spindle_rpm() override { return exec_.spindle_rpm(); }
+    std::uint64_t input_bits() override {
+        if (runner_.cfg_.standalone) return exec_.input_bits();
+        sync_if_behind();
+        return runner_.link_.input_bits();
+    }
+    std::uint64_t output_bits() override {
+        if (runner_.cfg_.standalone) return exec_.output_bits();
+        sync_if_behind();
+        return runner_.link_.output_bits();
+    }
+    double spindle_rpm() override {
+        if (runner_.cfg_.standalone) return exec_.spindle_rpm();
+        sync_if_behind();
+        return runner_.link_.spindle_rpm();
+    }
     double mm_per_program_unit() override { return exec_.mm_per_program_unit(); }
     bool incremental_mode() override { return exec_.incremental_mode(); }
     bool cycle_return_to_r() override { return exec_.cycle_return_to_r(); }
@@ -67,6 +83,10 @@ class ProgramRunner::LiveMachine final : public interp::MachineQuery {
     }
 
   private:
+    void sync_if_behind() {
+        if (!runner_.machine_current()) runner_.sync(runner_.last_loc_);
+    }
+
     ProgramRunner& runner_;
     interp::Executor& exec_;
 };
@@ -133,6 +153,21 @@ void ProgramRunner::sync(const interp::SourceLoc& loc) {
     }
     waiting_.store(false, std::memory_order_relaxed);
     current_ = true;
+}
+
+void ProgramRunner::adopt_probe_result(const interp::SourceLoc& loc,
+                                       const interp::canon::ConditionalMove& cm) {
+    if (cfg_.standalone) return;  // the executor's model (g904_trip_mm) stands in
+    sync(loc);
+    interp::AxisVec pos{};
+    unsigned axes = 0;
+    for (const auto& w : cm.axes) {
+        if (!w) continue;
+        pos[w->axis] = link_.machine_pos_mm(w->axis);
+        axes |= 1u << w->axis;
+    }
+    executor_->adopt_machine_position(pos, axes);
+    if (!link_.probe_tripped()) throw interp::Error(loc, interp::untripped_message(cm, pos));
 }
 
 bool ProgramRunner::deliver() noexcept {

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "hal/worker.hpp"
+#include "interp/canon.hpp"
 #include "interp/canon_wire.hpp"
 
 namespace interp {
@@ -30,8 +31,14 @@ class MachineLink {
     virtual bool push(const interp::wire::Record& r) noexcept = 0;
     // Barriers (Sync records) the consumer has reached with the machine in position.
     virtual std::uint32_t barriers_reached() const noexcept = 0;
-    // Live machine position (mm, degrees for A B C), valid when a barrier was just reached.
+    // Live machine state, valid when a barrier was just reached: the position (mm, degrees for
+    // A B C), the digital inputs and outputs (bit n = port n), the spindle speed (rpm), and
+    // whether the last conditional move (G904) stopped because its inputs came.
     virtual double machine_pos_mm(int axis) const noexcept = 0;
+    virtual std::uint64_t input_bits() const noexcept = 0;
+    virtual std::uint64_t output_bits() const noexcept = 0;
+    virtual double spindle_rpm() const noexcept = 0;
+    virtual bool probe_tripped() const noexcept = 0;
     // Polled by the runner's thread: true gives the rest of the program up.
     virtual bool abort_requested() const noexcept { return false; }
     // Called by the runner's thread whenever its status (line, waiting, done, failed) may have
@@ -82,6 +89,10 @@ class ProgramRunner {
     void sync(const interp::SourceLoc& loc);
     // True when nothing was sent since the last barrier was reached: the machine is current.
     bool machine_current() const noexcept { return current_; }
+    // After a conditional move (G904) was sent: waits until the machine has made it, then the
+    // interpreter's model takes the point where it stopped; a move whose inputs never came is
+    // an error at `loc` (NCX-3's alarm).
+    void adopt_probe_result(const interp::SourceLoc& loc, const interp::canon::ConditionalMove& cm);
 
   private:
     class Sink;

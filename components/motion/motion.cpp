@@ -129,6 +129,7 @@ class Motion : public hal::Instance {
         offset_before_mm_.assign(joint_count_, 0.0);
         offset_after_mm_.assign(joint_count_, 0.0);
         pos_lim_seen_.assign(joint_count_, 0);
+        lim_prev_cmd_mm_.assign(joint_count_, 0.0);
         neg_lim_seen_.assign(joint_count_, 0);
         shared_function<&Motion::take_commands>("=motion-command-handler");
         shared_function<&Motion::update>("=motion-controller");
@@ -217,10 +218,12 @@ class Motion : public hal::Instance {
         sampler_->set_rapid_override(clamp_override(rapid_override_));
         sampler_->set_hold(feed_hold_ || !enabled);
         sampler_->set_single_block(single_block_);
+        sampler_->set_inputs(read_inputs());
         if (resume_rose_ && sampler_->status().block_paused) sampler_->resume_block();
         const motion::MotionSample s = sampler_->advance(p.s);
         const motion::SamplerStatus& st = sampler_->status();
         action_pos_mm_ = s.pos_mm;  // standing on an action: where the machine stands
+        apply_sync_outputs();
         if (enabled) run_pending_action(s.line, p.s);
 
         for (const AxisPins& a : axes_) *a.pos_cmd = s.pos_mm[a.axis];
@@ -310,17 +313,23 @@ class Motion : public hal::Instance {
             for (std::size_t j = 0; j < joint_count_; ++j) amp_enable_out_[j] = false;
     }
 
-    // A limit switch that closes while the machine is enabled trips a fault. A switch still
-    // closed after the fault is cleared does not trip again, so the axis can be moved off it.
+    // A limit switch that closes while the machine is enabled trips a fault. One still closed
+    // after a reset lets the joint move off it (away from the switch) but trips again as soon
+    // as the joint is commanded further into it (LinuxCNC allows only the move away, too).
+    // joint_cmd_mm_ still holds last period's commands here: its step is the joint's direction.
     void check_limit_switches(bool enable) noexcept {
+        constexpr double kStill_mm = 1e-9;  // per period: rounding, not motion
         for (std::size_t j = 0; j < joint_count_; ++j) {
             const bool pos = pos_lim_sw_in_[j], neg = neg_lim_sw_in_[j];
-            const bool rose_pos = pos && !pos_lim_seen_[j], rose_neg = neg && !neg_lim_seen_[j];
+            const double step_mm = joint_cmd_mm_[j] - lim_prev_cmd_mm_[j];
+            lim_prev_cmd_mm_[j] = joint_cmd_mm_[j];
+            const bool trip_pos = pos && (!pos_lim_seen_[j] || step_mm > kStill_mm);
+            const bool trip_neg = neg && (!neg_lim_seen_[j] || step_mm < -kStill_mm);
             pos_lim_seen_[j] = pos;
             neg_lim_seen_[j] = neg;
-            if (!enable || limit_fault_ || !(rose_pos || rose_neg)) continue;
+            if (!enable || limit_fault_ || !(trip_pos || trip_neg)) continue;
             limit_fault_ = true;
-            const FaultCause cause = rose_pos ? FaultCause::PosLimit : FaultCause::NegLimit;
+            const FaultCause cause = trip_pos ? FaultCause::PosLimit : FaultCause::NegLimit;
             note_fault({cause, static_cast<int>(j), last_line_, {}});
             for (std::size_t k = 0; k < joint_count_; ++k) amp_enable_out_[k] = false;
         }
@@ -368,11 +377,17 @@ class Motion : public hal::Instance {
     bool step_action(const motion::Action& a, bool first, std::int32_t line) noexcept {
         switch (a.kind) {
             case motion::ActionKind::SpindleSpeed:
-                if (first) spindle_rpm_ = a.number;
-                return spindle_command(first);
+                spindle_rpm_ = a.number;
+                spindle_command();
+                return true;
             case motion::ActionKind::Spindle:
-                if (first) spindle_dir_ = a.value;
-                return spindle_command(first);
+                spindle_dir_ = a.value;
+                spindle_command();
+                return true;
+            case motion::ActionKind::SpindleAtSpeed:
+                return spindle_dir_ == 0 || spindle_at_speed_;
+            case motion::ActionKind::ConditionalMove:
+                return finish_probe();
             case motion::ActionKind::SpindleOrient:
                 return orient_spindle(a, first);
             case motion::ActionKind::Coolant:
@@ -401,15 +416,39 @@ class Motion : public hal::Instance {
         return true;
     }
 
-    // M03/M04/M05/S: the outputs change at once; a running spindle must report at-speed
-    // before motion goes on (LinuxCNC waits for spindle.0.at-speed likewise).
-    bool spindle_command(bool first) noexcept {
-        if (first) {
-            spindle_orient_ = false;
-            write_spindle();
-            return spindle_dir_ == 0;
+    // M03/M04/M05/S: the outputs change at once. spindle.0.at-speed is waited for by the
+    // SpindleAtSpeed record the planner puts before the next feed move.
+    void spindle_command() noexcept {
+        spindle_orient_ = false;
+        write_spindle();
+    }
+
+    std::uint64_t read_inputs() const noexcept {
+        std::uint64_t bits = 0;
+        for (std::size_t n = 0; n < num_dio_; ++n)
+            if (digital_in_[n].get()) bits |= std::uint64_t{1} << n;
+        return bits;
+    }
+
+    // G904: the sampler moves the axes; once they are all at rest the result goes to the
+    // pin and to the planner thread, which plans the rest of the program from there.
+    bool finish_probe() noexcept {
+        const motion::ProbeJog& jog = sampler_->probe_jog();
+        if (!jog.finished()) return false;
+        probe_tripped_ = jog.tripped();
+        if (feeder_) feeder_->report_probe(jog.pos_mm(), jog.tripped());
+        return true;
+    }
+
+    // M901 outputs synchronised with motion: due in the period their move starts.
+    void apply_sync_outputs() noexcept {
+        const motion::Sampler::SyncOutputs due = sampler_->take_sync_outputs();
+        if ((due.set | due.clear) == 0) return;
+        for (std::size_t n = 0; n < num_dio_; ++n) {
+            const std::uint64_t bit = std::uint64_t{1} << n;
+            if (due.set & bit) digital_out_[n] = true;
+            if (due.clear & bit) digital_out_[n] = false;
         }
-        return spindle_dir_ == 0 || spindle_at_speed_;
     }
 
     // M19-like oriented stop: the spindle stops, orient is raised with the angle, and motion
@@ -902,6 +941,7 @@ class Motion : public hal::Instance {
     hal::In<bool> single_block_{this, pin("motion.single-block")};
     hal::In<bool> resume_{this, pin("motion.resume")};
     hal::Out<bool> program_paused_{this, pin("motion.program-paused")};
+    hal::Out<bool> probe_tripped_{this, pin("motion.probe-tripped")};
     hal::Param<double> blend_tolerance_mm_{this, pin("motion.blend-tolerance"), 0.01};
 
     motion::SpscRing<motion::PreparedSegment> ring_;
@@ -936,6 +976,7 @@ class Motion : public hal::Instance {
     bool program_fault_ = false;  // a G906 timed out: latched for good, like a planner error
     EStop estop_ = EStop::Resetting;  // ready as soon as emc-enable-in reads TRUE
     std::vector<char> pos_lim_seen_, neg_lim_seen_;  // last values, for rising edges
+    std::vector<double> lim_prev_cmd_mm_;            // joint commands of the period before last
     FaultReport report_;
     std::int32_t last_line_ = 0;  // motion.program-line as last written
     std::uint32_t starved_count_ = 0;

@@ -37,16 +37,22 @@ double orient_angle_deg(const Orient& o) {
 }
 
 // Turns canonical commands into planner input. Machine commands (spindle, coolant, tool
-// change, outputs, waits, pauses) become action records after the motion before them has come
-// to rest; commands this machine has nothing for (messages, latches, G904, clamps) are counted
-// as ignored.
-class PlanSink final : public interp::CanonSink {
+// change, waits, pauses, conditional moves) become action records after the motion before them
+// has come to rest; M901 outputs ride on the next move's first record; encoder latches are
+// refused; commands this machine has nothing for (messages, clamps, M902) are counted as
+// ignored.
+class Sink final : public PlanSink {
   public:
-    PlanSink(motion::Planner& planner, const FeederConfig& cfg, ProgramFeeder& feeder)
+    Sink(motion::Planner& planner, const FeederConfig& cfg, ProgramFeeder& feeder)
         : planner_(planner), cfg_(cfg), feeder_(feeder), pos_mm_(planner.end_position()) {}
 
     void emit(const interp::Canon& c) override {
         std::visit([&](const auto& cmd) { handle(c.loc, cmd); }, c.cmd);
+    }
+
+    void restart_from(const motion::AxisArray& pos_mm) override {
+        planner_.reset(pos_mm);
+        pos_mm_ = pos_mm;
     }
 
   private:
@@ -58,12 +64,14 @@ class PlanSink final : public interp::CanonSink {
     void handle(const interp::SourceLoc& loc, const interp::canon::FeedLine& f) {
         motion::PathSegment seg = base_segment(loc, f.end_mm, f.flags);
         seg.feed_mm_s = feed_mm_s_;
+        wait_at_speed_if_due(loc);
         push(loc, seg);
     }
     void handle(const interp::SourceLoc& loc, const interp::canon::Arc& a) {
         motion::PathSegment seg = base_segment(loc, a.end_mm, a.flags);
         motioncomp::set_arc_geometry(seg, a);
         seg.feed_mm_s = feed_mm_s_;
+        wait_at_speed_if_due(loc);
         push(loc, seg);
     }
     // G61: tolerance 0, the planner's exact path (non-tangent corners are stopped at). G64 P:
@@ -80,34 +88,33 @@ class PlanSink final : public interp::CanonSink {
     void handle(const interp::SourceLoc& loc, const interp::canon::Dwell& d) {
         // The planner has no pause element: end the motion at rest, then queue a record that
         // stands still for the dwell time.
-        planner_.finish();
         if (d.seconds > 0) {
             const motion::PreparedSegment rec =
                 dwell_record(pos_mm_, d.seconds, loc.line, cfg_.plan.max_rate);
-            feeder_.collect(&rec);
+            rest(&rec);
         } else {
-            feeder_.collect();
+            rest(nullptr);
         }
     }
-    void handle(const interp::SourceLoc&, const interp::canon::ProgramEnd&) {
-        planner_.finish();
-        feeder_.collect();
-    }
+    void handle(const interp::SourceLoc&, const interp::canon::ProgramEnd&) { rest(nullptr); }
     // G906 without a port: motion comes to rest before the program goes on.
-    void handle(const interp::SourceLoc&, const interp::canon::Sync&) {
-        planner_.finish();
-        feeder_.collect();
-    }
+    void handle(const interp::SourceLoc&, const interp::canon::Sync&) { rest(nullptr); }
+    // LinuxCNC waits for spindle.0.at-speed at the start of the next feed move after a spindle
+    // start or a speed change, not at the spindle command: rapids before it run at once.
     void handle(const interp::SourceLoc& loc, const interp::canon::SetSpindleSpeed& s) {
+        if (spindle_running_) at_speed_due_ = true;
         queue(loc, {motion::ActionKind::SpindleSpeed, false, 0, s.rpm});
     }
     void handle(const interp::SourceLoc& loc, const interp::canon::Spindle& s) {
         const int dir = s.dir == interp::SpindleDir::Cw    ? 1
                         : s.dir == interp::SpindleDir::Ccw ? -1
                                                            : 0;
+        spindle_running_ = dir != 0;
+        at_speed_due_ = spindle_running_;
         queue(loc, {motion::ActionKind::Spindle, false, dir, 0});
     }
     void handle(const interp::SourceLoc& loc, const interp::canon::SpindleOrient& o) {
+        spindle_running_ = at_speed_due_ = false;
         queue(loc, {motion::ActionKind::SpindleOrient, false, 0, orient_angle_deg(o)});
     }
     void handle(const interp::SourceLoc& loc, const interp::canon::Coolant& c) {
@@ -119,9 +126,13 @@ class PlanSink final : public interp::CanonSink {
     void handle(const interp::SourceLoc& loc, const interp::canon::SetToolNumber& t) {
         queue(loc, {motion::ActionKind::SetToolNumber, false, t.tool, 0});
     }
+    // M901 is synchronised with motion (LinuxCNC's M62/M63): the output changes when the path
+    // reaches the start of the next move, blended or not, and nothing stops for it. Where the
+    // motion comes to rest before another move (a dwell, an action, the program's end) it
+    // changes there.
     void handle(const interp::SourceLoc& loc, const interp::canon::SetOutput& o) {
         check_port(loc, "M901", "output", "digital-out", o.port, cfg_.machine.digital_outputs);
-        queue(loc, {motion::ActionKind::SetOutput, o.level, o.port, 0});
+        feeder_.sync_output(o.port, o.level, next_move_id_ + 1, loc.line);
     }
     void handle(const interp::SourceLoc& loc, const interp::canon::WaitInput& w) {
         check_port(loc, "G906", "input", "digital-in", w.port, cfg_.machine.digital_inputs);
@@ -141,6 +152,47 @@ class PlanSink final : public interp::CanonSink {
     void handle(const interp::SourceLoc&, const interp::canon::Units&) {}
     void handle(const interp::SourceLoc&, const interp::canon::SelectPlane&) {}
     void handle(const interp::SourceLoc&, const interp::canon::SetFeedMode&) {}
+    // G904: the axes move on their own (motion::ProbeJog) from where the motion before came to
+    // rest; nothing after it can be planned before the machine has told where it stopped.
+    void handle(const interp::SourceLoc& loc, const interp::canon::ConditionalMove& cm) {
+        motion::PreparedSegment rec = motion::action_record(
+            pos_mm_, {motion::ActionKind::ConditionalMove, cm.flags.force_full_override, 0, 0},
+            loc.line);
+        for (int k = 0; k < motion::kProbeAxes; ++k) {
+            const auto& w = cm.axes[k];
+            if (!w) continue;
+            check_port(loc, "G904", "input", "digital-in", w->port, cfg_.machine.digital_inputs);
+            const int axis = k;  // the interpreter's X Y Z are the planner's first three axes
+            if (!cfg_.axis_present[axis])
+                throw std::runtime_error(
+                    fmt::format("{}:{}:{}: G904: axis {} moves but the machine has only "
+                                "coordinates={}",
+                                loc.file, loc.line, loc.col, kAxisLetters[axis], cfg_.coordinates));
+            motion::ProbeAxis& p = rec.probe[axis];
+            p.input = w->port;
+            p.level = w->level;
+            p.speed_mm_s = w->speed_mm_s;
+            // Never past the soft limit in the direction of travel (LinuxCNC's probe moves end
+            // inside the limits too); the maximum travel, if given, may stop it sooner.
+            const double to_limit = w->speed_mm_s > 0
+                                        ? cfg_.machine.max_limit_mm[axis] - pos_mm_[axis]
+                                        : pos_mm_[axis] - cfg_.machine.min_limit_mm[axis];
+            p.travel_mm = std::max(0.0, std::min(to_limit, w->max_travel_mm.value_or(to_limit)));
+        }
+        rest(&rec);
+        feeder_.await_probe(loc, cm);
+    }
+    // G916 / G918 / G919 ask the drives to latch their encoders on an input; this machine has
+    // no latch path from its drives, so a program that relies on one is refused.
+    void handle(const interp::SourceLoc& loc, const interp::canon::LatchConfig&) {
+        refuse_latch(loc, "G916");
+    }
+    void handle(const interp::SourceLoc& loc, const interp::canon::LatchClear&) {
+        refuse_latch(loc, "G918");
+    }
+    void handle(const interp::SourceLoc& loc, const interp::canon::LatchStopDistance&) {
+        refuse_latch(loc, "G919");
+    }
     template <class Other>
     void handle(const interp::SourceLoc&, const Other&) {
         feeder_.count_ignored();
@@ -153,6 +205,7 @@ class PlanSink final : public interp::CanonSink {
         seg.tolerance_mm = tolerance_mm_;
         seg.exact_stop = flags.exact_stop;  // G09
         seg.line = loc.line;
+        seg.move_id = ++next_move_id_;
         for (int k = 0; k < motion::kAxes; ++k) {
             if (!cfg_.axis_present[k] && std::fabs(seg.end_mm[k] - pos_mm_[k]) > 1e-9)
                 throw std::runtime_error(
@@ -164,9 +217,27 @@ class PlanSink final : public interp::CanonSink {
 
     // The motion so far ends at rest, then the action's record stands in the queue.
     void queue(const interp::SourceLoc& loc, const motion::Action& action) {
-        planner_.finish();
         const motion::PreparedSegment rec = motion::action_record(pos_mm_, action, loc.line);
-        feeder_.collect(&rec);
+        rest(&rec);
+    }
+
+    // The motion so far ends at rest; `extra` (an action or a dwell), if any, follows it.
+    void rest(const motion::PreparedSegment* extra) {
+        planner_.finish();
+        feeder_.collect_at_rest(pos_mm_, extra);
+    }
+
+    void wait_at_speed_if_due(const interp::SourceLoc& loc) {
+        if (!at_speed_due_) return;
+        at_speed_due_ = false;
+        queue(loc, {motion::ActionKind::SpindleAtSpeed, false, 0, 0});
+    }
+
+    [[noreturn]] static void refuse_latch(const interp::SourceLoc& loc, const char* code) {
+        throw std::runtime_error(fmt::format(
+            "{}:{}:{}: {}: encoder latches are not supported on this machine (the motion "
+            "component has no latch input from its drives)",
+            loc.file, loc.line, loc.col, code));
     }
 
     static void check_port(const interp::SourceLoc& loc, const char* code, const char* what,
@@ -218,6 +289,9 @@ class PlanSink final : public interp::CanonSink {
     motion::AxisArray pos_mm_;
     double feed_mm_s_ = 0;
     double tolerance_mm_ = cfg_.blend_tolerance_mm;  // the G61/G64 mode in force
+    std::uint32_t next_move_id_ = 0;                 // move_id of the last segment made
+    bool spindle_running_ = false;                   // as the program has commanded it
+    bool at_speed_due_ = false;  // the next feed move waits for spindle.0.at-speed
 };
 
 // Adds to `e` the points of the circle (centre c, radius r, in axes i, j) at the multiples of
@@ -258,9 +332,9 @@ Extent segment_reach(const motion::AxisArray& start, const motion::PathSegment& 
     return e;
 }
 
-std::unique_ptr<interp::CanonSink> make_plan_sink(motion::Planner& planner, const FeederConfig& cfg,
-                                                  ProgramFeeder& feeder) {
-    return std::make_unique<PlanSink>(planner, cfg, feeder);
+std::unique_ptr<PlanSink> make_plan_sink(motion::Planner& planner, const FeederConfig& cfg,
+                                         ProgramFeeder& feeder) {
+    return std::make_unique<Sink>(planner, cfg, feeder);
 }
 
 motion::PreparedSegment dwell_record(const motion::AxisArray& pos_mm, double seconds,

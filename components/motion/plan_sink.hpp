@@ -23,8 +23,15 @@ struct SinkConfig {
     int digital_inputs = 4;
 };
 
-std::unique_ptr<interp::CanonSink> make_plan_sink(motion::Planner& planner, const FeederConfig& cfg,
-                                                  ProgramFeeder& feeder);
+// The canonical-command sink, plus what the feeder tells it after a conditional move (G904):
+// the machine stopped at a place only known at run time, and the path goes on from there.
+class PlanSink : public interp::CanonSink {
+  public:
+    virtual void restart_from(const motion::AxisArray& pos_mm) = 0;
+};
+
+std::unique_ptr<PlanSink> make_plan_sink(motion::Planner& planner, const FeederConfig& cfg,
+                                         ProgramFeeder& feeder);
 
 // The axis-aligned box of the points a segment from `start_mm` reaches after its start: its end
 // and, for an arc, the extreme points of the circle it sweeps over. The start itself is left

@@ -47,6 +47,44 @@ std::uint32_t ProgramFeeder::acknowledge(bool in_position) noexcept {
     return acknowledged_;
 }
 
+void ProgramFeeder::await_probe(const interp::SourceLoc& loc,
+                                const interp::canon::ConditionalMove& cm) {
+    probe_pending_ = true;
+    probe_cmd_ = cm;
+    probe_where_ = fmt::format("{}:{}:{}", loc.file, loc.line, loc.col);
+}
+
+void ProgramFeeder::report_probe(const motion::AxisArray& pos_mm, bool tripped) noexcept {
+    probe_pos_mm_ = pos_mm;
+    probe_tripped_ = tripped;
+    probes_done_.fetch_add(1, std::memory_order_release);
+}
+
+bool ProgramFeeder::probe_result_waiting() const noexcept {
+    return probes_done_.load(std::memory_order_acquire) <
+           probes_sent_.load(std::memory_order_acquire);
+}
+
+// The path goes on from where the conditional move stopped. With the interpreter in-process
+// its model learns that point too, and a move that ended without its inputs is the alarm
+// NCX-3 asks for; with the interp component, that component does both (it waits at the
+// barrier it sends after a G904 and reads motion.probe-tripped).
+void ProgramFeeder::take_probe_result() {
+    probe_pending_ = false;
+    sink_->restart_from(probe_pos_mm_);
+    if (!executor_) return;
+    interp::AxisVec pos{};
+    unsigned axes = 0;
+    for (const auto& w : probe_cmd_.axes) {
+        if (!w) continue;
+        pos[w->axis] = probe_pos_mm_[w->axis];
+        axes |= 1u << w->axis;
+    }
+    executor_->adopt_machine_position(pos, axes);
+    if (!probe_tripped_)
+        fail(fmt::format("{}: {}", probe_where_, interp::untripped_message(probe_cmd_, pos)));
+}
+
 void ProgramFeeder::wait_for_lead() const noexcept {
     // A ring at least half full already holds more than one period can use (a period would
     // need records shorter than a 2000th of its travel each), so the period runs as it would
@@ -54,6 +92,7 @@ void ProgramFeeder::wait_for_lead() const noexcept {
     // the one or two records it used cost more than the planning (surface programs ran at 2x
     // real time).
     if (ring_.size() >= ring_.capacity() / 2) return;
+    if (probe_result_waiting()) return;  // the machine has to make the conditional move first
     // Also returns at a barrier motion has not reached yet (it must run there first); at one it
     // has acknowledged, it waits for the interpreter to go on, so the first period after a
     // queue-busting read is the same on every run.
@@ -61,6 +100,7 @@ void ProgramFeeder::wait_for_lead() const noexcept {
            ring_.free_slots() > 0) {
         const std::uint64_t b = barrier_state_.load(std::memory_order_acquire);
         if ((b & 1) && acknowledged_ < (b >> 1)) return;
+        if (probe_result_waiting()) return;
         std::this_thread::yield();
     }
 }
@@ -90,10 +130,52 @@ bool ProgramFeeder::stopping() const noexcept {
     return worker_.pause_requested() || abandoned_.load(std::memory_order_relaxed);
 }
 
+namespace {
+// Applies `bits` after what `set` / `clear` already hold: the later command wins for a port.
+void merge_outputs(std::uint64_t& set, std::uint64_t& clear, std::uint64_t set_bits,
+                   std::uint64_t clear_bits) {
+    set = (set & ~clear_bits) | set_bits;
+    clear = (clear & ~set_bits) | clear_bits;
+}
+}  // namespace
+
 void ProgramFeeder::collect(const motion::PreparedSegment* extra) {
     motion::PreparedSegment rec;
-    while (planner_->pop(rec)) outbox_.push_back(rec);
+    while (planner_->pop(rec)) {
+        while (!pending_outputs_.empty() && rec.move_id >= pending_outputs_.front().from_move_id) {
+            const PendingOutputs& p = pending_outputs_.front();
+            merge_outputs(rec.dout_set, rec.dout_clear, p.set, p.clear);
+            pending_outputs_.pop_front();
+        }
+        outbox_.push_back(rec);
+    }
     if (extra) outbox_.push_back(*extra);
+}
+
+void ProgramFeeder::collect_at_rest(const motion::AxisArray& pos_mm,
+                                    const motion::PreparedSegment* extra) {
+    collect();
+    // No move follows before the rest: the outputs change here, one standing record each.
+    for (const PendingOutputs& p : pending_outputs_) {
+        for (int port = 0; port < 64; ++port) {
+            const std::uint64_t bit = std::uint64_t{1} << port;
+            if (!((p.set | p.clear) & bit)) continue;
+            const motion::Action a{motion::ActionKind::SetOutput, (p.set & bit) != 0, port, 0};
+            outbox_.push_back(motion::action_record(pos_mm, a, p.line));
+        }
+    }
+    pending_outputs_.clear();
+    if (extra) outbox_.push_back(*extra);
+}
+
+void ProgramFeeder::sync_output(int port, bool level, std::uint32_t from_move_id,
+                                std::int32_t line) {
+    if (pending_outputs_.empty() || pending_outputs_.back().from_move_id != from_move_id)
+        pending_outputs_.push_back({0, 0, from_move_id, line});
+    PendingOutputs& p = pending_outputs_.back();
+    const std::uint64_t bit = std::uint64_t{1} << port;
+    merge_outputs(p.set, p.clear, level ? bit : 0, level ? 0 : bit);
+    p.line = line;
 }
 
 void ProgramFeeder::deliver() noexcept {
@@ -108,7 +190,7 @@ void ProgramFeeder::fail(const std::string& message) {
     failed_.store(true, std::memory_order_release);
     // Motion already planned stays valid: it runs out to rest.
     planner_->finish();
-    collect();
+    collect_at_rest(planner_->end_position(), nullptr);
     program_done_ = true;
 }
 
@@ -147,6 +229,22 @@ void ProgramFeeder::run() noexcept {
         if (ring_.free_slots() == 0) mark_ready();  // a full lead: start() may return
         reach_barrier_if_delivered();
         if (program_done_ && outbox_.empty()) break;
+        if (probe_pending_ && !program_done_) {
+            // Announced only once everything up to the conditional move is in the ring, so the
+            // lock-step servo function sees the same queue on every run.
+            if (!probe_announced_ && outbox_.empty()) {
+                probe_announced_ = true;
+                probes_sent_.fetch_add(1, std::memory_order_release);
+                mark_ready();  // start() may return: the machine has to move first
+            }
+            if (!probe_announced_ || probe_result_waiting()) {
+                std::this_thread::sleep_for(std::chrono::microseconds(100));
+                continue;
+            }
+            probe_announced_ = false;
+            take_probe_result();
+            continue;
+        }
         if (program_done_ || outbox_.size() >= kOutboxLimit || barrier_pending_) {
             std::this_thread::sleep_for(std::chrono::microseconds(200));
             continue;
@@ -155,7 +253,7 @@ void ProgramFeeder::run() noexcept {
             switch (step()) {
                 case Progress::End:
                     planner_->finish();
-                    collect();
+                    collect_at_rest(planner_->end_position(), nullptr);
                     program_done_ = true;
                     break;
                 case Progress::Starved:  // the interp component has not sent more yet
@@ -196,7 +294,7 @@ ProgramFeeder::Progress ProgramFeeder::read_stream() {
                 if (std::holds_alternative<interp::canon::Sync>(c.cmd)) {
                     // Whatever the sink made of it, the machine must come to rest here.
                     planner_->finish();
-                    collect();
+                    collect_at_rest(planner_->end_position(), nullptr);
                     barrier_pending_ = true;
                 }
                 return Progress::More;

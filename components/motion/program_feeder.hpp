@@ -22,6 +22,7 @@
 #include <string_view>
 
 #include "hal/worker.hpp"
+#include "interp/canon.hpp"
 #include "interp/canon_wire.hpp"
 #include "motion/planner.hpp"
 #include "motion/prepared.hpp"
@@ -92,6 +93,18 @@ class ProgramFeeder {
     void count_ignored() noexcept { ignored_.fetch_add(1, std::memory_order_relaxed); }
     // Moves the planner's finished records to the outbox, then appends `extra` if given.
     void collect(const motion::PreparedSegment* extra = nullptr);
+    // After the planner was finished (motion at rest at pos_mm): collects, changes the
+    // synchronised outputs still waiting for a move there, then appends `extra` if given.
+    void collect_at_rest(const motion::AxisArray& pos_mm, const motion::PreparedSegment* extra);
+    // M901: output `port` goes to `level` when the path starts the move with id
+    // `from_move_id` (or the first one after it that makes a record).
+    void sync_output(int port, bool level, std::uint32_t from_move_id, std::int32_t line);
+    // A conditional move (G904) was queued: nothing after it is planned until report_probe().
+    void await_probe(const interp::SourceLoc& loc, const interp::canon::ConditionalMove& cm);
+
+    // Servo thread, realtime-safe: the conditional move ended at pos_mm; tripped = every
+    // watched input reached its level.
+    void report_probe(const motion::AxisArray& pos_mm, bool tripped) noexcept;
 
   private:
     enum class Progress { More, Starved, End };
@@ -101,6 +114,8 @@ class ProgramFeeder {
     Progress read_stream();
     void reach_barrier_if_delivered();
     void leave_barrier() noexcept;
+    bool probe_result_waiting() const noexcept;
+    void take_probe_result();
     bool stopping() const noexcept;
     void deliver() noexcept;  // outbox -> ring, as far as it fits
     void fail(const std::string& message);
@@ -112,11 +127,19 @@ class ProgramFeeder {
 
     // Planning state: kept across stop()/start so a paused program continues where it was.
     std::unique_ptr<motion::Planner> planner_;
-    std::unique_ptr<interp::CanonSink> sink_;
+    std::unique_ptr<PlanSink> sink_;
     std::unique_ptr<interp::Executor> executor_;
     std::unique_ptr<interp::Interpreter> interpreter_;
     std::unique_ptr<interp::wire::Decoder> decoder_;  // stream mode
     std::deque<motion::PreparedSegment> outbox_;      // planned, in order, not yet in the ring
+    // Synchronised outputs waiting for the first record of move `from_move_id` or later, in
+    // program order (the planner's window may hold several moves, each with its own).
+    struct PendingOutputs {
+        std::uint64_t set = 0, clear = 0;
+        std::uint32_t from_move_id = 0;
+        std::int32_t line = 0;
+    };
+    std::deque<PendingOutputs> pending_outputs_;
     bool program_done_ = false;  // interpreter ended (or failed), planner finished
 
     std::atomic<bool> abandoned_{false};
@@ -132,6 +155,17 @@ class ProgramFeeder {
     std::atomic<std::uint64_t> barrier_state_{0};
     mutable std::uint64_t seen_barrier_state_ = 0;  // servo thread only
     std::uint32_t acknowledged_ = 0;                // servo thread only
+
+    // Conditional moves: the feeder queues one and waits; the servo thread writes the result
+    // and then counts it in probes_done_ (release), which the feeder reads (acquire).
+    bool probe_pending_ = false;    // feeder thread
+    bool probe_announced_ = false;  // counted in probes_sent_
+    interp::canon::ConditionalMove probe_cmd_;
+    std::string probe_where_;  // "file:line:col" of the G904
+    std::atomic<std::uint32_t> probes_sent_{0};
+    std::atomic<std::uint32_t> probes_done_{0};
+    motion::AxisArray probe_pos_mm_{};
+    bool probe_tripped_ = false;
 
     mutable std::mutex mutex_;
     std::string error_;

@@ -53,7 +53,13 @@ class FakeMachine : public interpcomp::MachineLink {
         return true;
     }
     std::uint32_t barriers_reached() const noexcept override { return reached_.load(); }
-    double machine_pos_mm(int axis) const noexcept override { return axis == 0 ? 7.5 : 0.0; }
+    double machine_pos_mm(int axis) const noexcept override {
+        return axis == 0 ? 7.5 : axis == 2 ? z_mm_.load() : 0.0;
+    }
+    std::uint64_t input_bits() const noexcept override { return 0b101; }
+    std::uint64_t output_bits() const noexcept override { return 0; }
+    double spindle_rpm() const noexcept override { return 1234; }
+    bool probe_tripped() const noexcept override { return tripped_.load(); }
     bool abort_requested() const noexcept override { return abort_.load(); }
 
     void reach_barriers() { reached_.store(barriers_sent()); }
@@ -66,6 +72,8 @@ class FakeMachine : public interpcomp::MachineLink {
         return lines_;
     }
     std::atomic<bool> abort_{false};
+    std::atomic<double> z_mm_{0};
+    std::atomic<bool> tripped_{true};
 
   private:
     mutable std::mutex mutex_;
@@ -172,6 +180,62 @@ TEST(ProgramRunner, ASyntaxErrorFailsBeforeStartReturns) {
     bool line2 = false;
     for (const auto& l : lines) line2 = line2 || l.rfind("2 feed ", 0) == 0;
     EXPECT_TRUE(line2);
+}
+
+// Reads of the ports and the spindle wait at a barrier like position reads, then take the
+// machine's values (inputs 0 and 2 on, 1234 rpm), not the model's (no inputs, 0 rpm).
+TEST(ProgramRunner, PortAndSpindleReadsComeFromTheMachine) {
+    Program prog("G90 G21\nG1 X1 F600\n#1 = #IMPORTMAP\nG1 X=#1\nM30\n");
+    FakeMachine machine;
+    ProgramRunner runner(RunnerConfig{prog.path(), "", false}, machine);
+    EXPECT_FALSE(runner.start_and_wait_ready());
+    ASSERT_TRUE(eventually([&] { return runner.waiting(); }));
+    machine.reach_barriers();
+    ASSERT_TRUE(eventually([&] { return runner.done(); })) << runner.error();
+    runner.stop();
+    bool x_from_machine = false;
+    for (const auto& l : machine.lines())
+        x_from_machine =
+            x_from_machine || (l.rfind("4 feed ", 0) == 0 && l.find("X5") != std::string::npos);
+    EXPECT_TRUE(x_from_machine) << ::testing::PrintToString(machine.lines());
+}
+
+// After a G904 the runner waits until the machine has made it, then its model starts from where
+// Z stopped: the incremental Z5 after it ends 5 mm above the machine's -3.25.
+TEST(ProgramRunner, ConditionalMoveContinuesFromWhereTheMachineStopped) {
+    Program prog("G90 G21\nG904 FZ-600 PZ1 LZ1 Z20\nG91 G0 Z5\nM30\n");
+    FakeMachine machine;
+    machine.z_mm_.store(-3.25);
+    ProgramRunner runner(RunnerConfig{prog.path(), "", false}, machine);
+    EXPECT_FALSE(runner.start_and_wait_ready());
+    ASSERT_TRUE(eventually([&] { return runner.waiting(); }));
+    EXPECT_EQ(machine.lines().back(), "2 sync");
+    machine.reach_barriers();
+    ASSERT_TRUE(eventually([&] { return runner.done(); })) << runner.error();
+    runner.stop();
+    bool z_from_stop = false;
+    for (const auto& l : machine.lines())
+        z_from_stop =
+            z_from_stop || (l.rfind("3 traverse ", 0) == 0 && l.find("Z1.75") != std::string::npos);
+    EXPECT_TRUE(z_from_stop) << ::testing::PrintToString(machine.lines());
+}
+
+// A G904 that ended without its input (probe-tripped FALSE) is an error at its location.
+TEST(ProgramRunner, ConditionalMoveWithoutItsInputFailsAtItsLine) {
+    Program prog("G90 G21\nG904 FZ-600 PZ1 LZ1 Z20\nG91 G0 Z5\nM30\n");
+    FakeMachine machine;
+    machine.z_mm_.store(-20);
+    machine.tripped_.store(false);
+    ProgramRunner runner(RunnerConfig{prog.path(), "", false}, machine);
+    EXPECT_FALSE(runner.start_and_wait_ready());
+    ASSERT_TRUE(eventually([&] { return runner.waiting(); }));
+    machine.reach_barriers();
+    ASSERT_TRUE(eventually([&] { return runner.failed(); }));
+    runner.stop();
+    EXPECT_EQ(runner.error(), prog.path() +
+                                  ":2:1: G904: Z stopped at -20 mm with input 1 not at level 1 "
+                                  "(the maximum travel or a soft limit came first)");
+    for (const auto& l : machine.lines()) EXPECT_NE(l.rfind("3 ", 0), 0u) << l;
 }
 
 }  // namespace

@@ -221,5 +221,10 @@ std::string to_text(const Canon& c);
 std::string to_text(const CanonCommand& c);
 // A number in the text form ("12.5", "-0.0001", "0").
 std::string fmt_num(double v);
+// Why a conditional move (G904) that ended without its inputs reaching their levels is an
+// error (NCX-3: the alarm is the default), with where each watched axis stopped:
+// "G904: Z stopped at -10 mm with input 3 not at level 1 (the maximum travel or a soft limit came
+// first)".
+std::string untripped_message(const canon::ConditionalMove& cm, const AxisVec& stop_mm);
 
 }  // namespace interp

@@ -107,6 +107,10 @@ class Executor final : public BlockExecutor, public MachineQuery {
     }
     // A persistent named parameter written by the program (front end).
     void set_persistent_param(std::string_view name, double value);
+    // The machine stopped where the program could not know beforehand (a conditional move,
+    // G904): on the axes in `axes` (bit a = axis a) the current point becomes machine_mm, and
+    // the program position follows through the active offsets and transforms.
+    void adopt_machine_position(const AxisVec& machine_mm, unsigned axes);
 
     const Settings& settings() const { return settings_; }
     const ExecState& state() const { return state_; }

@@ -183,4 +183,17 @@ std::string to_text(const Canon& c) {
     return fmt::format("{} {}", c.loc.line, to_text(c.cmd));
 }
 
+std::string untripped_message(const canon::ConditionalMove& cm, const AxisVec& stop_mm) {
+    std::string text = "G904:";
+    const char* sep = " ";
+    for (const auto& w : cm.axes) {
+        if (!w) continue;
+        text +=
+            fmt::format("{}{} stopped at {} mm with input {} not at level {}", sep, "XYZ"[w->axis],
+                        fmt_num(stop_mm[w->axis]), w -> port, w -> level ? 1 : 0);
+        sep = "; ";
+    }
+    return text + " (the maximum travel or a soft limit came first)";
+}
+
 }  // namespace interp

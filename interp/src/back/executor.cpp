@@ -326,6 +326,19 @@ double Executor::work_pos_mm(Axis axis) {
     return state_.pos.machine_mm[a] - off;
 }
 
+void Executor::adopt_machine_position(const AxisVec& machine_mm, unsigned axes) {
+    for (int a = 0; a < kMachineAxes; ++a)
+        if ((axes >> a) & 1u) state_.pos.machine_mm[a] = machine_mm[a];
+    AxisVec prog{};
+    for (int a = 0; a < kMachineAxes; ++a) prog[a] = work_pos_mm(static_cast<Axis>(a));
+    if (!xf_.identity()) {
+        const Eigen::Vector3d p = xf_.inverse(Eigen::Vector3d(prog[0], prog[1], prog[2]));
+        for (int a = 0; a < 3; ++a) prog[a] = p[a];
+    }
+    state_.pos.prog_mm = prog;
+    state_.moved_since_sync = false;
+}
+
 double Executor::spindle_rpm() {
     return state_.spindle.dir == SpindleDir::Stop ? 0.0 : state_.spindle.rpm;
 }

@@ -1,0 +1,134 @@
+// `cnc run` on the sim mill with the machine's I/O: outputs synchronised with motion (M901), the
+// spindle at-speed wait, and a tool setter touched by G904. The figures come from the mill's
+// INI (Z: 500 mm/s^2) and the programs, by hand.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cnc_run_harness.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+using cnc_test::run_cnc;
+using cnc_test::RunResult;
+using cnc_test::ScratchDir;
+using cnc_test::slurp;
+
+// configs/sim/mill.ini with its HAL files named by absolute path, plus `extra_hal` loaded last.
+std::string mill_ini_plus(const fs::path& extra_hal) {
+    std::istringstream in(slurp(fs::path(CNC_SOURCE_DIR) / "configs/sim/mill.ini"));
+    std::string text, line;
+    while (std::getline(in, line)) {
+        if (line.rfind("HALFILE = ", 0) == 0) {
+            line = fmt::format("HALFILE = {}/configs/sim/{}", CNC_SOURCE_DIR, line.substr(10));
+            if (line.find("io-loopback.hal") != std::string::npos)
+                line += fmt::format("\nHALFILE = {}", extra_hal.string());
+        }
+        text += line + "\n";
+    }
+    return text;
+}
+
+// A tool setter under the spindle: input 3 (dio-in-03) closes while Z is below `z_mm`.
+fs::path tool_setter_ini(const fs::path& dir, double z_mm) {
+    const fs::path hal = dir / "setter.hal";
+    std::ofstream(hal) << "loadrt comp names=setter\n"
+                          "addf setter servo-thread\n"
+                          "net z-pos-cmd => setter.in0\n"
+                       << fmt::format("setp setter.in1 {}\n", z_mm)
+                       << "net dio-in-03 <= setter.out\n";
+    const fs::path ini = dir / "setter.ini";
+    std::ofstream(ini) << mill_ini_plus(hal);
+    return ini;
+}
+
+std::vector<double> final_position(const std::string& out) {
+    const std::string key = "final position (mm): ";
+    const auto at = out.find(key);
+    std::vector<double> v;
+    if (at == std::string::npos) return v;
+    std::istringstream in(out.substr(at + key.size(), out.find('\n', at) - at - key.size()));
+    std::string name;
+    double x;
+    while (in >> name >> x) v.push_back(x);
+    return v;
+}
+
+// The S0 §3.5.3 tool-setting routine's moves: G904 down to the setter, then an incremental lift
+// measured from where Z stopped, and a read of that point.
+TEST(CncRunIo, ToolSetterG904StopsAtTheSwitchAndTheProgramGoesOnFromThere) {
+    ScratchDir scratch;
+    const fs::path ini = tool_setter_ini(scratch.path(), -12.5);
+    const fs::path prog = scratch.path() / "setter.ngc";
+    std::ofstream(prog) << "G90 G21\nG0 X10 Y10\nG0 Z-5\nG904 FZ-300 PZ3 LZ1 Z50\n"
+                           "G91 G0 Z5\nG90\n#1 = #CURMACHPOS.Z\nG0 X=20+#1\nM30\n";
+    const RunResult r =
+        run_cnc(fmt::format("'{}' '{}' --sim-clock", ini.string(), prog.string()), scratch.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+    const std::vector<double> pos = final_position(r.out);
+    ASSERT_EQ(pos.size(), 3u) << r.out;
+    // why: from Z-5 the jog ramps to 5 mm/s in 10 periods (0.025 mm at 500 mm/s^2), then moves
+    // 5 um a period: Z = -5.025 - 0.005 k. At k = 1495 it is -12.5 exactly, where the comparator
+    // (out = in1 > in0) stays FALSE; at -12.505 it closes, motion sees it in the next period and
+    // brakes from 5 mm/s: 10 periods of 4.75, 4.25 ... 0.25 um = 0.025 mm, so Z stops at -12.530.
+    // The lift of 5 mm from there ends at -7.530; #CURMACHPOS.Z reads that point, so X = 20 + Z.
+    EXPECT_NEAR(pos[2], -7.530, 1e-4);
+    EXPECT_NEAR(pos[0], 20 + pos[2], 1e-4);
+    EXPECT_NEAR(pos[1], 10, 1e-9);
+}
+
+TEST(CncRunIo, G904WithoutItsInputIsAnErrorAtItsLine) {
+    ScratchDir scratch;
+    const fs::path ini = tool_setter_ini(scratch.path(), -50);  // never reached
+    const fs::path prog = scratch.path() / "miss.ngc";
+    std::ofstream(prog) << "G90 G21\nG0 Z-5\n  G904 FZ-300 PZ3 LZ1 Z2\nG0 Z0\nM30\n";
+    const RunResult r =
+        run_cnc(fmt::format("'{}' '{}' --sim-clock", ini.string(), prog.string()), scratch.path());
+    EXPECT_EQ(r.exit_code, 1);
+    // why: 2 mm of maximum travel from Z-5 lands exactly on -7; the G904 is at column 3.
+    EXPECT_NE(r.err.find(prog.string() +
+                         ":3:3: G904: Z stopped at -7 mm with input 3 not at level 1 (the "
+                         "maximum travel or a soft limit came first)"),
+              std::string::npos)
+        << r.err;
+    const std::vector<double> pos = final_position(r.out);
+    ASSERT_EQ(pos.size(), 3u) << r.out;
+    EXPECT_NEAR(pos[2], -7, 1e-9);  // line 4 never ran
+}
+
+// M901 between two collinear moves switches the output without stopping the path.
+TEST(CncRunIo, M901DoesNotStopThePath) {
+    ScratchDir scratch;
+    const fs::path prog = scratch.path() / "out.ngc";
+    std::ofstream(prog) << "G90 G21\nG1 X10 F600\nM901 H0 P1\nG1 X20\nM30\n";
+    const fs::path csv = scratch.path() / "t.csv";
+    const RunResult r = run_cnc(fmt::format("configs/sim/mill.ini '{}' --sim-clock --trace '{}'",
+                                            prog.string(), csv.string()),
+                                scratch.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::istringstream in(slurp(csv));
+    std::string line;
+    std::getline(in, line);  // t,line,x,y,z,j0,j1,j2,vel
+    int near_x10 = 0;
+    while (std::getline(in, line)) {
+        std::vector<double> row;
+        std::istringstream cells(line);
+        std::string cell;
+        while (std::getline(cells, cell, ',')) row.push_back(std::stod(cell));
+        if (row.size() != 9 || std::fabs(row[2] - 10) > 0.2) continue;
+        ++near_x10;
+        // why: F600 is 10 mm/s; a stop at X10 would show speeds down to 0 within 0.05 mm of it.
+        EXPECT_NEAR(row[8], 10, 1e-6) << line;
+    }
+    EXPECT_GE(near_x10, 39);  // 0.4 mm at 10 mm/s: 40 periods
+}
+
+}  // namespace
