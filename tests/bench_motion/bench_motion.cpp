@@ -46,19 +46,6 @@ PlannerConfig config_for(const Settings& s, double jerk) {
     return cfg;
 }
 
-std::vector<PreparedSegment> plan_all(const PlannerConfig& cfg, const bench::BenchProgram& prog) {
-    Planner planner(cfg, prog.start_mm);
-    std::vector<PreparedSegment> out;
-    PreparedSegment rec;
-    for (const PathSegment& seg : prog.segments) {
-        planner.push(seg);
-        while (planner.pop(rec)) out.push_back(rec);
-    }
-    planner.finish();
-    while (planner.pop(rec)) out.push_back(rec);
-    return out;
-}
-
 double bound_s(const Settings& s, const bench::BenchProgram& prog) {
     double t = 0;
     AxisArray pos = prog.start_mm;
@@ -82,7 +69,7 @@ struct RunResult {
 RunResult run(const PlannerConfig& cfg, const bench::BenchProgram& prog,
               std::FILE* trace_out = nullptr) {
     RunResult res;
-    std::vector<PreparedSegment> recs = plan_all(cfg, prog);
+    std::vector<PreparedSegment> recs = bench::plan_all(cfg, prog);
     for (const auto& r : recs) res.planned_s += r.profile.duration_s;
     SpscRing<PreparedSegment> ring(recs.size() + 1);
     for (const auto& r : recs) ring.try_push(r);
@@ -111,7 +98,7 @@ RunResult run(const PlannerConfig& cfg, const bench::BenchProgram& prog,
 // Lines where the plan spends the most time beyond length / min(F, vmax).
 void print_excess(const Settings& s, const PlannerConfig& cfg, const bench::BenchProgram& prog,
                   int count) {
-    std::vector<PreparedSegment> recs = plan_all(cfg, prog);
+    std::vector<PreparedSegment> recs = bench::plan_all(cfg, prog);
     std::map<int, double> spent, ideal;
     for (const auto& r : recs) spent[r.line] += r.profile.duration_s;
     AxisArray pos = prog.start_mm;

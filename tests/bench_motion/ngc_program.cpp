@@ -105,4 +105,17 @@ double programmed_length_mm(const PathSegment& seg, const AxisArray& start) {
     return e.length_mm;
 }
 
+std::vector<PreparedSegment> plan_all(const PlannerConfig& cfg, const BenchProgram& prog) {
+    Planner planner(cfg, prog.start_mm);
+    std::vector<PreparedSegment> out;
+    PreparedSegment rec;
+    for (const PathSegment& seg : prog.segments) {
+        planner.push(seg);
+        while (planner.pop(rec)) out.push_back(rec);
+    }
+    planner.finish();
+    while (planner.pop(rec)) out.push_back(rec);
+    return out;
+}
+
 }  // namespace motion::bench

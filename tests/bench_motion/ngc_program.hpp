@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "motion/planner.hpp"
+#include "motion/prepared.hpp"
 #include "motion/types.hpp"
 
 namespace motion::bench {
@@ -23,5 +25,9 @@ BenchProgram read_program(const std::string& path, double default_tolerance_mm);
 
 // Length of a programmed move starting at start_mm (arc length for arcs).
 double programmed_length_mm(const PathSegment& seg, const AxisArray& start_mm);
+
+// Every record the planner makes for the whole program, in order (planned ahead of time, as
+// the benchmarks time the planner and the sampler separately).
+std::vector<PreparedSegment> plan_all(const PlannerConfig& cfg, const BenchProgram& prog);
 
 }  // namespace motion::bench

@@ -45,19 +45,6 @@ PlannerConfig config_for(double jerk_mm_s3) {
     return cfg;
 }
 
-std::vector<PreparedSegment> plan_all(const PlannerConfig& cfg, const bench::BenchProgram& prog) {
-    Planner planner(cfg, prog.start_mm);
-    std::vector<PreparedSegment> out;
-    PreparedSegment rec;
-    for (const PathSegment& seg : prog.segments) {
-        planner.push(seg);
-        while (planner.pop(rec)) out.push_back(rec);
-    }
-    planner.finish();
-    while (planner.pop(rec)) out.push_back(rec);
-    return out;
-}
-
 // The override for period i: fixed, or stepping between 100 % and 120 % every `toggle` periods
 // (long enough for the rate to get there without a jerk limit: 0.2 / 0.1 per s = 2 s).
 enum class OverrideMode { At100, At120, Toggle };
@@ -124,7 +111,7 @@ void bm_period(benchmark::State& state, const CostCase& c) {
     const PlannerConfig cfg = config_for(c.jerk_mm_s3);
     const bench::BenchProgram prog =
         bench::read_program(std::string(MOTION_BENCH_DIR) + "/" + c.program, kTolerance_mm);
-    Feeder feeder(plan_all(cfg, prog));
+    Feeder feeder(bench::plan_all(cfg, prog));
     SpscRing<PreparedSegment> ring(1024);
     feeder.top_up(ring);
     Sampler sampler(sampler_config(cfg), ring, prog.start_mm);
@@ -194,7 +181,7 @@ struct Fnv1a {
 bool digest_run(const std::string& path, const bench::BenchProgram& prog, double jerk,
                 OverrideMode mode) {
     const PlannerConfig cfg = config_for(jerk);
-    std::vector<PreparedSegment> recs = plan_all(cfg, prog);
+    std::vector<PreparedSegment> recs = bench::plan_all(cfg, prog);
     SpscRing<PreparedSegment> ring(recs.size() + 1);
     for (const auto& r : recs) ring.try_push(r);
     Sampler sampler(sampler_config(cfg), ring, prog.start_mm);

@@ -24,45 +24,10 @@ using cnc_test::RunResult;
 using cnc_test::ScratchDir;
 using cnc_test::slurp;
 
-// The text after "KEY: " on the summary line that starts with KEY, or "".
-std::string summary_field(const std::string& out, const std::string& key) {
-    std::istringstream in(out);
-    std::string line;
-    const std::string prefix = key + ": ";
-    while (std::getline(in, line))
-        if (line.compare(0, prefix.size(), prefix) == 0) return line.substr(prefix.size());
-    return "";
-}
-
-double summary_number(const std::string& out, const std::string& key) {
-    const std::string field = summary_field(out, key);
-    return field.empty() ? NAN : std::stod(field);
-}
-
-// "x 1.0  y 2.0 ..." -> {1.0, 2.0, ...}
-std::vector<double> summary_axes(const std::string& out, const std::string& key) {
-    std::vector<double> v;
-    std::istringstream in(summary_field(out, key));
-    std::string name;
-    double x;
-    while (in >> name >> x) v.push_back(x);
-    return v;
-}
-
-std::vector<std::vector<double>> csv_rows(const std::string& text, std::string& header) {
-    std::istringstream in(text);
-    std::getline(in, header);
-    std::vector<std::vector<double>> rows;
-    std::string line;
-    while (std::getline(in, line)) {
-        std::vector<double> row;
-        std::istringstream cells(line);
-        std::string cell;
-        while (std::getline(cells, cell, ',')) row.push_back(std::stod(cell));
-        rows.push_back(row);
-    }
-    return rows;
-}
+using cnc_test::csv_rows;
+using cnc_test::summary_axes;
+using cnc_test::summary_field;
+using cnc_test::summary_number;
 
 const char* kPocketArgs = "configs/sim/mill.ini examples/pocket.ngc --sim-clock";
 

@@ -51,15 +51,7 @@ fs::path tool_setter_ini(const fs::path& dir, double z_mm) {
 }
 
 std::vector<double> final_position(const std::string& out) {
-    const std::string key = "final position (mm): ";
-    const auto at = out.find(key);
-    std::vector<double> v;
-    if (at == std::string::npos) return v;
-    std::istringstream in(out.substr(at + key.size(), out.find('\n', at) - at - key.size()));
-    std::string name;
-    double x;
-    while (in >> name >> x) v.push_back(x);
-    return v;
+    return cnc_test::summary_axes(out, "final position (mm)");
 }
 
 // The S0 §3.5.3 tool-setting routine's moves: G904 down to the setter, then an incremental lift

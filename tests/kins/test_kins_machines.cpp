@@ -50,15 +50,7 @@ std::string ini_with(const std::string& name, const std::vector<Edit>& edits) {
 
 // "j0 0.0000  j1 2.4000 ..." of the summary -> {0.0, 2.4, ...}
 std::vector<double> max_ferrors(const std::string& out) {
-    const std::string key = "max following error (mm): ";
-    const auto at = out.find(key);
-    std::vector<double> v;
-    if (at == std::string::npos) return v;
-    std::istringstream in(out.substr(at + key.size(), out.find('\n', at) - at - key.size()));
-    std::string name;
-    double x;
-    while (in >> name >> x) v.push_back(x);
-    return v;
+    return cnc_test::summary_axes(out, "max following error (mm)");
 }
 
 struct MachineRun {
@@ -75,20 +67,7 @@ struct MachineRun {
     fs::path trace_path() const { return scratch.path() / "t.csv"; }
 };
 
-std::vector<std::vector<double>> csv_rows(const std::string& text, std::string& header) {
-    std::istringstream in(text);
-    std::getline(in, header);
-    std::vector<std::vector<double>> rows;
-    std::string line;
-    while (std::getline(in, line)) {
-        std::vector<double> row;
-        std::istringstream cells(line);
-        std::string cell;
-        while (std::getline(cells, cell, ',')) row.push_back(std::stod(cell));
-        rows.push_back(row);
-    }
-    return rows;
-}
+using cnc_test::csv_rows;
 
 // A pure Y move on a CoreXY turns both motors, A = X + Y forward and B = X - Y backward, at
 // the Y speed (50 mm/s here). motion is first in the servo thread, so its f-error compares this

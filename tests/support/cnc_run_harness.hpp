@@ -8,12 +8,14 @@
 #include <stdlib.h>
 #include <sys/wait.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace cnc_test {
 
@@ -62,6 +64,47 @@ inline RunResult run_cnc(const std::string& args, const fs::path& scratch,
     r.out = slurp(out);
     r.err = slurp(err);
     return r;
+}
+
+// The text after "KEY: " on the summary line that starts with KEY, or "".
+inline std::string summary_field(const std::string& out, const std::string& key) {
+    std::istringstream in(out);
+    std::string line;
+    const std::string prefix = key + ": ";
+    while (std::getline(in, line))
+        if (line.compare(0, prefix.size(), prefix) == 0) return line.substr(prefix.size());
+    return "";
+}
+
+inline double summary_number(const std::string& out, const std::string& key) {
+    const std::string field = summary_field(out, key);
+    return field.empty() ? NAN : std::stod(field);
+}
+
+// "x 1.0  y 2.0 ..." (or "j0 0.1  j1 0.2 ...") -> {1.0, 2.0, ...}
+inline std::vector<double> summary_axes(const std::string& out, const std::string& key) {
+    std::vector<double> v;
+    std::istringstream in(summary_field(out, key));
+    std::string name;
+    double x;
+    while (in >> name >> x) v.push_back(x);
+    return v;
+}
+
+// A --trace CSV: the header line into `header`, then one row of numbers per line.
+inline std::vector<std::vector<double>> csv_rows(const std::string& text, std::string& header) {
+    std::istringstream in(text);
+    std::getline(in, header);
+    std::vector<std::vector<double>> rows;
+    std::string line;
+    while (std::getline(in, line)) {
+        std::vector<double> row;
+        std::istringstream cells(line);
+        std::string cell;
+        while (std::getline(cells, cell, ',')) row.push_back(std::stod(cell));
+        rows.push_back(row);
+    }
+    return rows;
 }
 
 }  // namespace cnc_test
