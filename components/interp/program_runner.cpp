@@ -11,6 +11,7 @@
 #include "interp/dialect.hpp"
 #include "interp/executor.hpp"
 #include "interp/interpreter.hpp"
+#include "../machine_program.hpp"
 
 namespace interpcomp {
 
@@ -197,14 +198,10 @@ void ProgramRunner::finish(const std::string& error) {
 
 void ProgramRunner::open_program() {
     sink_ = std::make_unique<Sink>(*this);
-    interp::InterpreterOptions options;
-    options.main_m99_loops = false;  // a looping program would run forever
-    if (!cfg_.dialect.empty()) options.dialect = interp::find_dialect(cfg_.dialect);
-    interp::BackendConfig backend;
-    backend.optional_stop = true;  // M01 reaches motion, which obeys motion.optional-stop
-    executor_ = std::make_unique<interp::Executor>(*sink_, backend);
+    executor_ = std::make_unique<interp::Executor>(*sink_, machine_program::backend_config());
     machine_ = std::make_unique<LiveMachine>(*this, *executor_);
-    interpreter_ = std::make_unique<interp::Interpreter>(*executor_, *machine_, options);
+    interpreter_ = std::make_unique<interp::Interpreter>(
+        *executor_, *machine_, machine_program::interpreter_options(cfg_.dialect));
     interpreter_->open(cfg_.program_path);
 }
 

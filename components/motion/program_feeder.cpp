@@ -10,6 +10,7 @@
 #include <utility>
 #include <variant>
 
+#include "../machine_program.hpp"
 #include "interp/canon.hpp"
 #include "interp/canon_wire.hpp"
 #include "interp/dialect.hpp"
@@ -201,13 +202,9 @@ void ProgramFeeder::open_program() {
         decoder_ = std::make_unique<interp::wire::Decoder>();
         return;
     }
-    interp::InterpreterOptions options;
-    options.main_m99_loops = false;  // a looping program would plan forever
-    if (!cfg_.dialect.empty()) options.dialect = interp::find_dialect(cfg_.dialect);
-    interp::BackendConfig backend;
-    backend.optional_stop = true;  // M01 reaches motion, which obeys motion.optional-stop
-    executor_ = std::make_unique<interp::Executor>(*sink_, backend);
-    interpreter_ = std::make_unique<interp::Interpreter>(*executor_, *executor_, options);
+    executor_ = std::make_unique<interp::Executor>(*sink_, machine_program::backend_config());
+    interpreter_ = std::make_unique<interp::Interpreter>(
+        *executor_, *executor_, machine_program::interpreter_options(cfg_.dialect));
     interpreter_->open(cfg_.program_path);
 }
 
