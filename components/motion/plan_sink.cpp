@@ -59,6 +59,7 @@ class Sink final : public PlanSink {
     void handle(const interp::SourceLoc& loc, const interp::canon::Traverse& t) {
         motion::PathSegment seg = base_segment(loc, t.end_mm, t.flags);
         seg.rapid = true;
+        seg.rapid_mm_s = rapid_mm_s_;
         push(loc, seg);
     }
     void handle(const interp::SourceLoc& loc, const interp::canon::FeedLine& f) {
@@ -84,6 +85,11 @@ class Sink final : public PlanSink {
     }
     void handle(const interp::SourceLoc&, const interp::canon::SetFeedRate& f) {
         feed_mm_s_ = f.feed_mm_s;
+    }
+    // NcStudio's F in a G00 block (FEATURES G00-3): the rapids that follow go no faster than
+    // this, nor faster than the axis limits allow; 0 = the axis limits alone.
+    void handle(const interp::SourceLoc&, const interp::canon::SetRapidRate& r) {
+        rapid_mm_s_ = r.rapid_mm_s;
     }
     void handle(const interp::SourceLoc& loc, const interp::canon::Dwell& d) {
         // The planner has no pause element: end the motion at rest, then queue a record that
@@ -288,6 +294,7 @@ class Sink final : public PlanSink {
     ProgramFeeder& feeder_;
     motion::AxisArray pos_mm_;
     double feed_mm_s_ = 0;
+    double rapid_mm_s_ = 0;  // programmed rapid rate; 0 = as fast as the axes allow
     double tolerance_mm_ = cfg_.blend_tolerance_mm;  // the G61/G64 mode in force
     std::uint32_t next_move_id_ = 0;                 // move_id of the last segment made
     bool spindle_running_ = false;                   // as the program has commanded it

@@ -49,6 +49,9 @@ void validate_segment(const PathSegment& seg) {
     if (!seg.rapid && !(seg.feed_mm_s > 0 && std::isfinite(seg.feed_mm_s)))
         throw PlanError(seg.line, "feed move needs a positive feed rate (got " +
                                       std::to_string(seg.feed_mm_s) + " mm/s)");
+    if (seg.rapid && !(seg.rapid_mm_s >= 0 && std::isfinite(seg.rapid_mm_s)))
+        throw PlanError(
+            seg.line, "rapid rate must be >= 0 (got " + std::to_string(seg.rapid_mm_s) + " mm/s)");
     if (!(seg.tolerance_mm >= 0)) throw PlanError(seg.line, "blend tolerance must be >= 0");
     if (seg.kind == SegmentKind::Arc &&
         !(std::isfinite(seg.centre_mm[0]) && std::isfinite(seg.centre_mm[1])))
@@ -112,7 +115,8 @@ void Planner::push(const PathSegment& seg) {
         if (have_pending_) pending_.exact_stop |= seg.exact_stop;
         return;
     }
-    next.feed_mm_s = seg.rapid ? 0 : seg.feed_mm_s;
+    next.feed_mm_s = seg.rapid ? seg.rapid_mm_s : seg.feed_mm_s;
+    next.rapid = seg.rapid;
     next.tolerance_mm = seg.tolerance_mm;
     next.exact_stop = seg.exact_stop;
     next.line = seg.line;
@@ -279,23 +283,25 @@ void Planner::close_piece(Piece& p, Piece* next) {
     bool rough = p.rough_start || jn.rough;
     Element e = trimmed(p.geom, p.trim_start_mm, jn.blend_l_mm);
     // Only a line blended at both ends can vanish, and its junctions are smooth.
-    if (e.length_mm > kMinLength_mm) add_item(e, p.feed_mm_s, jn.cap_mm_s, rough, p);
+    if (e.length_mm > kMinLength_mm) add_item(e, p.feed_mm_s, jn.cap_mm_s, rough, p, p.rapid);
     if (!next) return;
     double f1 = p.feed_mm_s, f2 = next->feed_mm_s;
     double feed = f1 > 0 && f2 > 0 ? std::min(f1, f2) : std::max(f1, f2);
+    const bool rapid = p.rapid && next->rapid;  // blends between two rapids are rapid too
     switch (jn.blend) {
         case Blend::Curve:
-            add_item(jn.curve, feed, jn.curve_end_cap_mm_s, jn.rough || jn.curve_end_rough, *next);
+            add_item(jn.curve, feed, jn.curve_end_cap_mm_s, jn.rough || jn.curve_end_rough, *next,
+                     rapid);
             next->trim_start_mm = jn.blend_l_mm;
             next->rough_start = jn.curve_end_rough;
             return;
         case Blend::Parabola:
             add_item(make_parabola(p.geom.end, p.geom.a, next->geom.a, jn.blend_l_mm), feed, kInf,
-                     false, *next);
+                     false, *next, rapid);
             break;
         case Blend::Quartic:
             add_item(make_blend(p.geom.end, p.geom.a, next->geom.a, jn.blend_l_mm), feed, kInf,
-                     false, *next);
+                     false, *next, rapid);
             break;
         case Blend::None:
             break;
@@ -305,7 +311,7 @@ void Planner::close_piece(Piece& p, Piece* next) {
 }
 
 void Planner::add_item(const Element& e, double feed, double end_cap, bool rough,
-                       const Piece& owner) {
+                       const Piece& owner, bool rapid) {
     Item it;
     it.geom = e;
     double cut = reserve_ + (rough ? cfg_.junction_share : 0);
@@ -314,7 +320,7 @@ void Planner::add_item(const Element& e, double feed, double end_cap, bool rough
     it.rough = rough;
     it.line = owner.line;
     it.move_id = owner.move_id;
-    it.rapid = feed <= 0;  // blends between two rapids are rapid too
+    it.rapid = rapid;
     items_.push_back(it);
 }
 

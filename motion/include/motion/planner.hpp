@@ -72,7 +72,8 @@ class Planner {
   private:
     struct Piece {
         Element geom;
-        double feed_mm_s;  // 0 = rapid
+        double feed_mm_s;  // rapids: the rapid rate cap, 0 = none
+        bool rapid = false;
         double tolerance_mm;
         bool exact_stop;
         std::int32_t line;
@@ -117,7 +118,8 @@ class Planner {
     // junction share of one period's jerk (infinite without a jerk limit).
     double curvature_step_cap(const AxisArray& d2_before, const AxisArray& d2_after) const;
     void close_piece(Piece& p, Piece* next);
-    void add_item(const Element& e, double feed, double end_cap, bool rough, const Piece& owner);
+    void add_item(const Element& e, double feed, double end_cap, bool rough, const Piece& owner,
+                  bool rapid);
     std::size_t plan_and_emit(bool all);  // returns how many records it emitted
     bool can_join(const Group& g, const Item& it) const;
     void build_groups();

@@ -36,8 +36,11 @@ struct PathSegment {
     std::array<double, 2> centre_mm{};
     int turns = 1;
 
-    double feed_mm_s = 0;     // requested path speed; ignored for rapids
-    bool rapid = false;       // G0: as fast as the axis limits allow
+    double feed_mm_s = 0;  // requested path speed; ignored for rapids
+    bool rapid = false;    // G0: as fast as the axis limits allow
+    // Rapids only: the programmed rapid rate (NcStudio's F in a G00 block), a cap on the path
+    // speed below the axis limits; 0 = no cap.
+    double rapid_mm_s = 0;
     bool exact_stop = false;  // G09 (or G61 handled by tolerance 0): stop at this move's end
     // Blend tolerance for the corner at this move's end (G64 P). 0 = exact path (G61): corners
     // that are not tangent are stopped at, never rounded.

@@ -1,0 +1,52 @@
+// `cnc run` on the sim mill with NcStudio's machine-side program codes: the rapid rate of F in
+// a G00 block. The figures come from configs/sim/mill.ini (X: 100 mm/s, 1000 mm/s^2,
+// 20000 mm/s^3) and the programs, by hand.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "cnc_run_harness.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+using cnc_test::run_cnc;
+using cnc_test::RunResult;
+using cnc_test::ScratchDir;
+
+RunResult run_on_mill(const ScratchDir& scratch, const std::string& program,
+                      const std::string& extra_args = "") {
+    const fs::path prog = scratch.path() / "prog.ngc";
+    std::ofstream(prog) << program;
+    return run_cnc(
+        fmt::format("configs/sim/mill.ini '{}' --sim-clock {}", prog.string(), extra_args),
+        scratch.path());
+}
+
+TEST(CncRunCodes, G00WithFRunsAtTheProgrammedRapidRate) {
+    ScratchDir scratch;
+    const RunResult r = run_on_mill(scratch, "G90 G21\nG00 X100 F600\nM30\n");
+    ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+    // why: F600 in a G00 block caps the rapid at 10 mm/s (the axis allows 100 mm/s).
+    EXPECT_NEAR(cnc_test::summary_axes(r.out, "max velocity (mm/s)").at(0), 10, 1e-3) << r.out;
+    // why: a jerk-limited start to v (and the stop from it) that never reaches the acceleration
+    // limit takes 2 sqrt(v / j) and covers v sqrt(v / j), so the move takes L / v + 2 sqrt(v / j)
+    // = 10 + 2 sqrt(10 / j) s: 10.0447 s at j = 20000 mm/s^3, 10.0471 s with the planner's
+    // 10 % reserve (18000). At the axis maximum it would be about 1.16 s.
+    EXPECT_NEAR(cnc_test::summary_number(r.out, "motion time"), 10.047, 0.005) << r.out;
+}
+
+TEST(CncRunCodes, G00RapidRateAboveTheAxisLimitRunsAtTheLimit) {
+    ScratchDir scratch;
+    const RunResult r = run_on_mill(scratch, "G90 G21\nG00 Z-60 F6000\nM30\n");
+    ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+    // why: F6000 is 100 mm/s; Z allows 50 mm/s.
+    EXPECT_NEAR(cnc_test::summary_axes(r.out, "max velocity (mm/s)").at(2), 50, 1e-3) << r.out;
+}
+
+}  // namespace
