@@ -18,9 +18,12 @@ inline interp::InterpreterOptions interpreter_options(const std::string& dialect
     return options;
 }
 
-inline interp::BackendConfig backend_config() {
+inline interp::BackendConfig backend_config(const std::string& dialect) {
     interp::BackendConfig backend;
     backend.optional_stop = true;  // M01 reaches motion, which obeys motion.optional-stop
+    // As `cnc canon --dialect ncstudio-v54`: V5.4's M10/M11 clamp, M902 sets 0, M06 changes.
+    backend.v54_compat = dialect == "ncstudio-v54";
+    backend.t_changes_tool = !backend.v54_compat;
     return backend;
 }
 

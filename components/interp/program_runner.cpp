@@ -198,7 +198,8 @@ void ProgramRunner::finish(const std::string& error) {
 
 void ProgramRunner::open_program() {
     sink_ = std::make_unique<Sink>(*this);
-    executor_ = std::make_unique<interp::Executor>(*sink_, machine_program::backend_config());
+    executor_ =
+        std::make_unique<interp::Executor>(*sink_, machine_program::backend_config(cfg_.dialect));
     machine_ = std::make_unique<LiveMachine>(*this, *executor_);
     interpreter_ = std::make_unique<interp::Interpreter>(
         *executor_, *machine_, machine_program::interpreter_options(cfg_.dialect));

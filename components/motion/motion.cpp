@@ -103,7 +103,8 @@ class Motion : public hal::Instance {
           num_dio_(read_num_dio()),
           digital_out_(this, pin("motion.digital-out-{:02}"), num_dio_),
           digital_in_(this, pin("motion.digital-in-{:02}"), num_dio_),
-          ring_(ring_capacity()) {
+          ring_(ring_capacity()),
+          messages_(this, stream_name("messages"), interp::wire::kStreamLayout, kMessageDepth) {
         check_num_joints();
         program_path_ = arg("program").value_or("");
         if (!program_path_.empty() && !std::ifstream(program_path_))
@@ -158,6 +159,7 @@ class Motion : public hal::Instance {
         for (char c : coordinates_) cfg.axis_present[motion::axis_index(c)] = true;
         cfg.blend_tolerance_mm = blend_tolerance_mm_;
         cfg.machine = sink_config();
+        cfg.on_text = [this](const interp::Canon& c) { publish_text(c); };
         feeder_ = std::make_unique<motioncomp::ProgramFeeder>(std::move(cfg), ring_);
         const bool failed_early = feeder_->start_and_wait_ready();
         // An error found before the first servo period is a configuration error: say so now,
@@ -226,7 +228,8 @@ class Motion : public hal::Instance {
         apply_sync_outputs();
         if (enabled) run_pending_action(s.line, p.s);
 
-        for (const AxisPins& a : axes_) *a.pos_cmd = s.pos_mm[a.axis];
+        // Machine coordinates: the planner's frame plus the shifts M902 has set.
+        for (const AxisPins& a : axes_) *a.pos_cmd = s.pos_mm[a.axis] + home_shift_mm_[a.axis];
         check_kinematics();  // after the actions: a tool offset set now applies now
         kins_.kins().inverse(s.pos_mm, joint_cmd_mm_);
         check_joint_motion(p.s, s.line);
@@ -253,6 +256,29 @@ class Motion : public hal::Instance {
     }
 
   private:
+    static constexpr std::uint32_t kMessageDepth = 256;  // records of motion.messages
+
+    // A stream of this instance: motion.NAME, or INSTANCE.NAME for an instance given a name.
+    std::string stream_name(std::string_view n) const {
+        const std::string p = pin(fmt::format("motion.{}", n));
+        return p[0] == '=' ? p.substr(1) : fmt::format("{}.{}", name(), n);
+    }
+
+    // The feeder thread (the stream's only producer): M801 messages and warnings go into
+    // motion.messages in the canonical stream's wire form, for `cnc run` or another reader.
+    // A text that does not fit (nobody reads the stream) is dropped whole, so a reader never
+    // sees half a command; motion.message-count still counts the messages reached.
+    void publish_text(const interp::Canon& c) {
+        text_records_.clear();
+        text_encoder_.command(c, text_records_);
+        if (messages_.depth() - messages_.used() < text_records_.size()) return;
+        hal::Value v[interp::wire::kWireFields];
+        for (const interp::wire::Record& r : text_records_) {
+            for (std::size_t i = 0; i < r.size(); ++i) v[i].u64 = r[i];
+            messages_.push(v);
+        }
+    }
+
     // The feeder thread's read of the canonical stream (canon=).
     bool pop_canon(interp::wire::Record& r) noexcept {
         hal::Value v[interp::wire::kWireFields];
@@ -327,6 +353,9 @@ class Motion : public hal::Instance {
             const bool trip_neg = neg && (!neg_lim_seen_[j] || step_mm < -kStill_mm);
             pos_lim_seen_[j] = pos;
             neg_lim_seen_[j] = neg;
+            // Masked (M802 P131072): no trip; a switch still closed when they are obeyed again
+            // lets the joint move off it only, like one closed before enabling.
+            if (limits_masked_) continue;
             if (!enable || limit_fault_ || !(trip_pos || trip_neg)) continue;
             limit_fault_ = true;
             const FaultCause cause = trip_pos ? FaultCause::PosLimit : FaultCause::NegLimit;
@@ -410,6 +439,19 @@ class Motion : public hal::Instance {
                 return pause(first);
             case motion::ActionKind::OptionalPause:
                 return !optional_stop_ || pause(first);
+            case motion::ActionKind::Message:
+                message_count_ = static_cast<std::uint32_t>(a.value);
+                return true;
+            case motion::ActionKind::MaskLimits:
+                limits_masked_ = a.flag;
+                limits_masked_pin_ = a.flag;
+                return true;
+            case motion::ActionKind::HomeDone:
+                home_shift_mm_[static_cast<std::size_t>(a.value)] = a.number;
+                return true;
+            case motion::ActionKind::SpindleClamp:
+                spindle_clamp_ = a.flag;
+                return true;
             case motion::ActionKind::None:
                 break;
         }
@@ -443,6 +485,7 @@ class Motion : public hal::Instance {
     // M901 outputs synchronised with motion: due in the period their move starts.
     void apply_sync_outputs() noexcept {
         const motion::Sampler::SyncOutputs due = sampler_->take_sync_outputs();
+        if (due.message > 0) message_count_ = due.message;
         if ((due.set | due.clear) == 0) return;
         for (std::size_t n = 0; n < num_dio_; ++n) {
             const std::uint64_t bit = std::uint64_t{1} << n;
@@ -600,7 +643,7 @@ class Motion : public hal::Instance {
         for (std::size_t j = 0; j < joint_count_; ++j) joint_fb_mm_[j] = motor_pos_fb_[j].get();
         motion::AxisArray fb_mm = cmd_mm;  // axes the kinematics lacks keep their command
         kins_.kins().forward(joint_fb_mm_, fb_mm);
-        for (const AxisPins& a : axes_) *a.pos_fb = fb_mm[a.axis];
+        for (const AxisPins& a : axes_) *a.pos_fb = fb_mm[a.axis] + home_shift_mm_[a.axis];
     }
 
     // Printed once, at the first stop or unload after the run.
@@ -942,12 +985,20 @@ class Motion : public hal::Instance {
     hal::In<bool> resume_{this, pin("motion.resume")};
     hal::Out<bool> program_paused_{this, pin("motion.program-paused")};
     hal::Out<bool> probe_tripped_{this, pin("motion.probe-tripped")};
+    hal::Out<std::uint32_t> message_count_{this, pin("motion.message-count")};
+    hal::Out<bool> limits_masked_pin_{this, pin("motion.limits-masked")};
+    hal::Out<bool> spindle_clamp_{this, pin("spindle.0.clamp")};
     hal::Param<double> blend_tolerance_mm_{this, pin("motion.blend-tolerance"), 0.01};
 
     motion::SpscRing<motion::PreparedSegment> ring_;
     std::unique_ptr<motion::Sampler> sampler_;
     std::unique_ptr<motioncomp::ProgramFeeder> feeder_;
-    std::optional<hal::Stream> canon_;  // canon=: the interp component's stream
+    std::optional<hal::Stream> canon_;                // canon=: the interp component's stream
+    hal::Stream messages_;                            // motion.messages: M801 texts and warnings
+    interp::wire::Encoder text_encoder_;              // feeder thread only
+    std::vector<interp::wire::Record> text_records_;  // feeder thread only
+    motion::AxisArray home_shift_mm_{};  // machine coordinate minus planner frame (M902)
+    bool limits_masked_ = false;         // M802 P131072 until P131073
     hal::Out<std::uint32_t> canon_sync_{this, pin("motion.canon-sync")};
     std::string program_path_;
     std::string dialect_;

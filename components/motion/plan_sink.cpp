@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <set>
 #include <stdexcept>
 #include <variant>
 
@@ -39,8 +40,9 @@ double orient_angle_deg(const Orient& o) {
 // Turns canonical commands into planner input. Machine commands (spindle, coolant, tool
 // change, waits, pauses, conditional moves) become action records after the motion before them
 // has come to rest; M901 outputs ride on the next move's first record; encoder latches are
-// refused; commands this machine has nothing for (messages, clamps, M902) are counted as
-// ignored.
+// refused; M801 messages ride on the next move like M901 outputs; M802's documented integer
+// messages mask the limit switches or close the look-ahead; other commands this machine has
+// nothing for are counted as ignored.
 class Sink final : public PlanSink {
   public:
     Sink(motion::Planner& planner, const FeederConfig& cfg, ProgramFeeder& feeder)
@@ -53,6 +55,12 @@ class Sink final : public PlanSink {
     void restart_from(const motion::AxisArray& pos_mm) override {
         planner_.reset(pos_mm);
         pos_mm_ = pos_mm;
+    }
+
+    motion::AxisArray to_machine(const motion::AxisArray& pos_mm) const override {
+        motion::AxisArray out = pos_mm;
+        for (int k = 0; k < motion::kAxes; ++k) out[k] += shift_mm_[k];
+        return out;
     }
 
   private:
@@ -71,6 +79,8 @@ class Sink final : public PlanSink {
     void handle(const interp::SourceLoc& loc, const interp::canon::Arc& a) {
         motion::PathSegment seg = base_segment(loc, a.end_mm, a.flags);
         motioncomp::set_arc_geometry(seg, a);
+        seg.centre_mm[0] -= shift_mm_[seg.plane_first];  // into the planner's frame
+        seg.centre_mm[1] -= shift_mm_[seg.plane_second];
         seg.feed_mm_s = feed_mm_s_;
         wait_at_speed_if_due(loc);
         push(loc, seg);
@@ -153,6 +163,53 @@ class Sink final : public PlanSink {
     void handle(const interp::SourceLoc& loc, const interp::canon::ToolOffset& t) {
         queue(loc, {motion::ActionKind::ToolOffset, false, 0, t.offset_mm[2]});
     }
+    // M10 / M11 (V5.4; the 6th edition sends a warning instead): spindle.0.clamp.
+    void handle(const interp::SourceLoc& loc, const interp::canon::SpindleClamp& c) {
+        queue(loc, {motion::ActionKind::SpindleClamp, c.clamp, 0, 0});
+    }
+    // M801: shown when the path reaches the next move, without stopping it (like M901).
+    void handle(const interp::SourceLoc& loc, const interp::canon::Message& m) {
+        feeder_.sync_message(interp::Canon{loc, m}, next_move_id_ + 1);
+    }
+    void handle(const interp::SourceLoc& loc, const interp::canon::Warning& w) {
+        feeder_.post_text(interp::Canon{loc, w});
+    }
+    // M802 P: the integer messages S0 §3.10 documents for the machine (FEATURES IO-4, IO-5).
+    void handle(const interp::SourceLoc& loc, const interp::canon::IntMessage& m) {
+        switch (m.code) {
+            case kMaskLimits:
+            case kRestoreLimits:
+                queue(loc, {motion::ActionKind::MaskLimits, m.code == kMaskLimits, 0, 0});
+                return;
+            case kCloseBuffer:
+            case kOpenBuffer:
+                // No look-ahead past this point; while closed every block ends at rest before
+                // the next one starts (push()).
+                rest(nullptr);
+                buffer_closed_ = m.code == kCloseBuffer;
+                return;
+            default:
+                feeder_.count_ignored();
+                if (!unhandled_codes_.insert(m.code).second) return;  // warned once per code
+                feeder_.post_text(interp::Canon{
+                    loc, interp::canon::Warning{fmt::format(
+                             "M802 P{}: this machine has no handler for that integer message; "
+                             "ignored",
+                             m.code)}});
+        }
+    }
+    // M902 H<a>: homing done; this point is the axis's machine coordinate `position_mm` from now
+    // on. The motors stay where they are: the shift goes into the frame (see PlanSink).
+    void handle(const interp::SourceLoc& loc, const interp::canon::HomeDone& h) {
+        const int axis = h.axis;  // 0..3 = X Y Z A, the planner's first four axes
+        if (axis < 0 || axis >= motion::kAxes || !cfg_.axis_present[axis])
+            throw std::runtime_error(fmt::format(
+                "{}:{}:{}: M902: axis {} is not on this machine (coordinates={})", loc.file,
+                loc.line, loc.col, axis >= 0 && axis < motion::kAxes ? kAxisLetters[axis] : '?',
+                cfg_.coordinates));
+        shift_mm_[axis] = h.position_mm - pos_mm_[axis];
+        queue(loc, {motion::ActionKind::HomeDone, false, axis, shift_mm_[axis]});
+    }
     // Informational: end points already include offsets, units and plane are per move.
     void handle(const interp::SourceLoc&, const interp::canon::Offsets&) {}
     void handle(const interp::SourceLoc&, const interp::canon::Units&) {}
@@ -180,9 +237,9 @@ class Sink final : public PlanSink {
             p.speed_mm_s = w->speed_mm_s;
             // Never past the soft limit in the direction of travel (LinuxCNC's probe moves end
             // inside the limits too); the maximum travel, if given, may stop it sooner.
-            const double to_limit = w->speed_mm_s > 0
-                                        ? cfg_.machine.max_limit_mm[axis] - pos_mm_[axis]
-                                        : pos_mm_[axis] - cfg_.machine.min_limit_mm[axis];
+            const double here_mm = pos_mm_[axis] + shift_mm_[axis];  // machine coordinate
+            const double to_limit = w->speed_mm_s > 0 ? cfg_.machine.max_limit_mm[axis] - here_mm
+                                                      : here_mm - cfg_.machine.min_limit_mm[axis];
             p.travel_mm = std::max(0.0, std::min(to_limit, w->max_travel_mm.value_or(to_limit)));
         }
         rest(&rec);
@@ -208,6 +265,7 @@ class Sink final : public PlanSink {
                                      const interp::canon::MoveFlags& flags) {
         motion::PathSegment seg;
         seg.end_mm = to_axes(end);
+        for (int k = 0; k < motion::kAxes; ++k) seg.end_mm[k] -= shift_mm_[k];
         seg.tolerance_mm = tolerance_mm_;
         seg.exact_stop = flags.exact_stop;  // G09
         seg.line = loc.line;
@@ -261,20 +319,26 @@ class Sink final : public PlanSink {
         constexpr double kSlack_mm = 1e-9;  // rounding of arc extremes computed from angles
         for (int k = 0; k < motion::kAxes; ++k) {
             if (!cfg_.axis_present[k]) continue;
-            const double lo = cfg_.machine.min_limit_mm[k], hi = cfg_.machine.max_limit_mm[k];
+            // The limits are machine coordinates; the reach is in the planner's frame.
+            const double lo = cfg_.machine.min_limit_mm[k] - shift_mm_[k];
+            const double hi = cfg_.machine.max_limit_mm[k] - shift_mm_[k];
             const bool low = reach.lo_mm[k] < lo - kSlack_mm;
             if (!low && reach.hi_mm[k] <= hi + kSlack_mm) continue;
             throw std::runtime_error(
                 fmt::format("{}:{}:{}: the move takes {} to {} mm, which exceeds the soft limit "
                             "axis.{}.{}-limit = {} mm",
                             loc.file, loc.line, loc.col, kAxisLetters[k],
-                            interp::fmt_num(low ? reach.lo_mm[k] : reach.hi_mm[k]), kLowerAxes[k],
-                            low ? "min" : "max", interp::fmt_num(low ? lo : hi)));
+                            interp::fmt_num((low ? reach.lo_mm[k] : reach.hi_mm[k]) + shift_mm_[k]),
+                            kLowerAxes[k], low ? "min" : "max",
+                            interp::fmt_num((low ? lo : hi) + shift_mm_[k])));
         }
     }
 
     void push(const interp::SourceLoc& loc, const motion::PathSegment& seg) {
         check_soft_limits(loc, seg);
+        // The look-ahead closed (M802 P196609): the block before ends at rest first.
+        if (buffer_closed_ && seg.line != last_move_line_) rest(nullptr);
+        last_move_line_ = seg.line;
         try {
             planner_.push(seg);
         } catch (const motion::PlanError& e) {
@@ -298,7 +362,17 @@ class Sink final : public PlanSink {
     double tolerance_mm_ = cfg_.blend_tolerance_mm;  // the G61/G64 mode in force
     std::uint32_t next_move_id_ = 0;                 // move_id of the last segment made
     bool spindle_running_ = false;                   // as the program has commanded it
-    bool at_speed_due_ = false;  // the next feed move waits for spindle.0.at-speed
+    bool at_speed_due_ = false;     // the next feed move waits for spindle.0.at-speed
+    motion::AxisArray shift_mm_{};  // machine coordinate minus planner frame, per axis (M902)
+    bool buffer_closed_ = false;    // between M802 P196609 and P196608
+    std::int32_t last_move_line_ = -1;
+    std::set<std::int64_t> unhandled_codes_;  // M802 codes already warned about
+
+    // M802 P values (S0 §3.10; FEATURES M802-1).
+    static constexpr std::int64_t kMaskLimits = 0x20000;     // 131072
+    static constexpr std::int64_t kRestoreLimits = 0x20001;  // 131073
+    static constexpr std::int64_t kCloseBuffer = 0x30001;    // 196609
+    static constexpr std::int64_t kOpenBuffer = 0x30000;     // 196608
 };
 
 // Adds to `e` the points of the circle (centre c, radius r, in axes i, j) at the multiples of

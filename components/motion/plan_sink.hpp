@@ -25,9 +25,17 @@ struct SinkConfig {
 
 // The canonical-command sink, plus what the feeder tells it after a conditional move (G904):
 // the machine stopped at a place only known at run time, and the path goes on from there.
+//
+// Frames: the planner works in the frame the machine started in (the motors' frame); the program's
+// machine coordinates differ from it by the shift each M902 sets (homing: "this point is now
+// the home position"). The sink subtracts the shift from every end point, and the servo side
+// adds it back on axis.L.pos-cmd, so the motors never jump.
 class PlanSink : public interp::CanonSink {
   public:
-    virtual void restart_from(const motion::AxisArray& pos_mm) = 0;
+    virtual void restart_from(const motion::AxisArray& pos_mm) = 0;  // planner frame
+    // The machine coordinates of a planner-frame position, with the shifts the program has set
+    // so far (the ones in force where the planning has got to).
+    virtual motion::AxisArray to_machine(const motion::AxisArray& pos_mm) const = 0;
 };
 
 std::unique_ptr<PlanSink> make_plan_sink(motion::Planner& planner, const FeederConfig& cfg,

@@ -74,11 +74,12 @@ void ProgramFeeder::take_probe_result() {
     probe_pending_ = false;
     sink_->restart_from(probe_pos_mm_);
     if (!executor_) return;
+    const motion::AxisArray machine_mm = sink_->to_machine(probe_pos_mm_);
     interp::AxisVec pos{};
     unsigned axes = 0;
     for (const auto& w : probe_cmd_.axes) {
         if (!w) continue;
-        pos[w->axis] = probe_pos_mm_[w->axis];
+        pos[w->axis] = machine_mm[w->axis];
         axes |= 1u << w->axis;
     }
     executor_->adopt_machine_position(pos, axes);
@@ -146,6 +147,7 @@ void ProgramFeeder::collect(const motion::PreparedSegment* extra) {
         while (!pending_outputs_.empty() && rec.move_id >= pending_outputs_.front().from_move_id) {
             const PendingOutputs& p = pending_outputs_.front();
             merge_outputs(rec.dout_set, rec.dout_clear, p.set, p.clear);
+            rec.message = std::max(rec.message, p.message);
             pending_outputs_.pop_front();
         }
         outbox_.push_back(rec);
@@ -164,19 +166,38 @@ void ProgramFeeder::collect_at_rest(const motion::AxisArray& pos_mm,
             const motion::Action a{motion::ActionKind::SetOutput, (p.set & bit) != 0, port, 0};
             outbox_.push_back(motion::action_record(pos_mm, a, p.line));
         }
+        if (p.message == 0) continue;
+        const motion::Action m{motion::ActionKind::Message, false,
+                               static_cast<std::int32_t>(p.message), 0};
+        outbox_.push_back(motion::action_record(pos_mm, m, p.line));
     }
     pending_outputs_.clear();
     if (extra) outbox_.push_back(*extra);
 }
 
-void ProgramFeeder::sync_output(int port, bool level, std::uint32_t from_move_id,
-                                std::int32_t line) {
+ProgramFeeder::PendingOutputs& ProgramFeeder::pending_for(std::uint32_t from_move_id,
+                                                          std::int32_t line) {
     if (pending_outputs_.empty() || pending_outputs_.back().from_move_id != from_move_id)
         pending_outputs_.push_back({0, 0, from_move_id, line});
     PendingOutputs& p = pending_outputs_.back();
+    p.line = line;
+    return p;
+}
+
+void ProgramFeeder::sync_output(int port, bool level, std::uint32_t from_move_id,
+                                std::int32_t line) {
+    PendingOutputs& p = pending_for(from_move_id, line);
     const std::uint64_t bit = std::uint64_t{1} << port;
     merge_outputs(p.set, p.clear, level ? bit : 0, level ? 0 : bit);
-    p.line = line;
+}
+
+void ProgramFeeder::sync_message(const interp::Canon& message, std::uint32_t from_move_id) {
+    pending_for(from_move_id, message.loc.line).message = ++messages_;
+    post_text(message);
+}
+
+void ProgramFeeder::post_text(const interp::Canon& text) {
+    if (cfg_.on_text) cfg_.on_text(text);
 }
 
 void ProgramFeeder::deliver() noexcept {
@@ -202,7 +223,8 @@ void ProgramFeeder::open_program() {
         decoder_ = std::make_unique<interp::wire::Decoder>();
         return;
     }
-    executor_ = std::make_unique<interp::Executor>(*sink_, machine_program::backend_config());
+    executor_ =
+        std::make_unique<interp::Executor>(*sink_, machine_program::backend_config(cfg_.dialect));
     interpreter_ = std::make_unique<interp::Interpreter>(
         *executor_, *executor_, machine_program::interpreter_options(cfg_.dialect));
     interpreter_->open(cfg_.program_path);

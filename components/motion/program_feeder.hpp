@@ -48,6 +48,10 @@ struct FeederConfig {
     std::string coordinates;                         // for error messages
     double blend_tolerance_mm = 0;
     SinkConfig machine;  // soft limits and I/O counts the sink checks moves and commands against
+    // The program's texts for the operator (canon::Message for M801, canon::Warning), as they
+    // are planned, on the feeder thread. The n-th Message is message n of
+    // PreparedSegment::message, shown when the machine reaches it.
+    std::function<void(const interp::Canon&)> on_text;
 };
 
 class ProgramFeeder {
@@ -99,6 +103,11 @@ class ProgramFeeder {
     // M901: output `port` goes to `level` when the path starts the move with id
     // `from_move_id` (or the first one after it that makes a record).
     void sync_output(int port, bool level, std::uint32_t from_move_id, std::int32_t line);
+    // M801: the message is handed to on_text now and falls due, like an M901 output, when the
+    // path starts the move `from_move_id` (or comes to rest before it).
+    void sync_message(const interp::Canon& message, std::uint32_t from_move_id);
+    // A warning for the operator: handed to on_text now.
+    void post_text(const interp::Canon& text);
     // A conditional move (G904) was queued: nothing after it is planned until report_probe().
     void await_probe(const interp::SourceLoc& loc, const interp::canon::ConditionalMove& cm);
 
@@ -138,7 +147,10 @@ class ProgramFeeder {
         std::uint64_t set = 0, clear = 0;
         std::uint32_t from_move_id = 0;
         std::int32_t line = 0;
+        std::uint32_t message = 0;  // the last M801 message due with them, 0: none
     };
+    PendingOutputs& pending_for(std::uint32_t from_move_id, std::int32_t line);
+    std::uint32_t messages_ = 0;  // M801 messages planned so far
     std::deque<PendingOutputs> pending_outputs_;
     bool program_done_ = false;  // interpreter ended (or failed), planner finished
 

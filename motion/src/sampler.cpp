@@ -98,6 +98,7 @@ void Sampler::enter_front() noexcept {
     if (front_entered_ || ring_.size() == 0) return;
     front_entered_ = true;
     const PreparedSegment& rec = ring_.peek(0);
+    outputs_due_.message = std::max(outputs_due_.message, rec.message);
     if ((rec.dout_set | rec.dout_clear) == 0) return;
     outputs_due_.set = (outputs_due_.set & ~rec.dout_clear) | rec.dout_set;
     outputs_due_.clear = (outputs_due_.clear & ~rec.dout_set) | rec.dout_clear;

@@ -1,6 +1,6 @@
 // `cnc run` on the sim mill with NcStudio's machine-side program codes: the rapid rate of F in
-// a G00 block. The figures come from configs/sim/mill.ini (X: 100 mm/s, 1000 mm/s^2,
-// 20000 mm/s^3) and the programs, by hand.
+// a G00 block, M801 messages and warnings shown to the user. The figures come from
+// configs/sim/mill.ini (X: 100 mm/s, 1000 mm/s^2, 20000 mm/s^3) and the programs, by hand.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -47,6 +47,38 @@ TEST(CncRunCodes, G00RapidRateAboveTheAxisLimitRunsAtTheLimit) {
     ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
     // why: F6000 is 100 mm/s; Z allows 50 mm/s.
     EXPECT_NEAR(cnc_test::summary_axes(r.out, "max velocity (mm/s)").at(2), 50, 1e-3) << r.out;
+}
+
+// The message is printed on a line of its own when the machine reaches it (X10, about 1.02 s
+// into the run: between the progress lines of 1 s and 2 s); warnings go to stderr, once per
+// unhandled M802 code.
+TEST(CncRunCodes, M801IsPrintedWhenReachedAndWarningsOnce) {
+    ScratchDir scratch;
+    const RunResult r =
+        run_on_mill(scratch,
+                    "G90 G21\nG1 X10 F600\nM801 MSG \"tool 2: check the clamp\"\nG1 X20\n"
+                    "M802 P12345\nM802 P12345\nM10\nM30\n");
+    ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+    const std::string prog = (scratch.path() / "prog.ngc").string();
+    const auto message = r.out.find("\n" + prog + ":3: message: tool 2: check the clamp\n");
+    const auto before = r.out.find("progress:     1.0 s");
+    const auto after = r.out.find("progress:     2.0 s");
+    ASSERT_NE(message, std::string::npos) << r.out;
+    ASSERT_NE(before, std::string::npos) << r.out;
+    ASSERT_NE(after, std::string::npos) << r.out;
+    EXPECT_LT(before, message) << r.out;
+    EXPECT_LT(message, after) << r.out;
+    const std::string warning =
+        prog +
+        ":5:1: warning: M802 P12345: this machine has no handler for that integer message; "
+        "ignored\n";
+    const auto first = r.err.find(warning);
+    EXPECT_NE(first, std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find(warning, first + 1), std::string::npos) << r.err;  // once
+    EXPECT_NE(r.err.find(prog + ":7:1: warning: M10 is an invalid instruction in NcStudio 6th "
+                                "edition; ignored\n"),
+              std::string::npos)
+        << r.err;
 }
 
 }  // namespace

@@ -25,6 +25,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -34,12 +35,14 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <variant>
 #include <vector>
 
 #include "backends.hpp"
 #include "hal/ini.hpp"
 #include "hal/script.hpp"
 #include "interp/block.hpp"
+#include "interp/canon_wire.hpp"
 #include "preview.hpp"
 #include "ring.hpp"
 #include "runtime.hpp"
@@ -377,6 +380,66 @@ class Progress {
     double next_plain_s_ = 1.0;
 };
 
+// The program's M801 messages and warnings, from motion's stream motion.messages (the canonical
+// stream's wire form): a warning is printed when it arrives, the n-th message when
+// motion.message-count reaches n (the machine has got there), each on a line of its own; on a
+// terminal the progress bar is cleared first and redrawn by its next update.
+class OperatorTexts {
+  public:
+    OperatorTexts(hal::Runtime& rt, bool tty)
+        : count_(try_probe(rt, "motion.message-count")), tty_(tty) {
+        try {
+            ring_ = rt.segment().at<hal::Ring>(rt.stream_offset("motion.messages"));
+        } catch (const hal::Error&) {
+            return;  // a motion without messages (or none loaded): nothing to show
+        }
+        if (ring_->fields != interp::wire::kWireFields) ring_ = nullptr;
+        record_.resize(interp::wire::kWireFields);
+    }
+
+    void poll() {
+        if (!ring_) return;
+        while (ring_->pop(record_.data())) take();
+        const double reached = count_ ? count_->number() : 0;
+        while (shown_ < reached && !messages_.empty()) {
+            clear_bar();
+            fmt::print("{}\n", messages_.front());
+            std::fflush(stdout);
+            messages_.pop_front();
+            ++shown_;
+        }
+    }
+
+  private:
+    void take() {
+        interp::wire::Record r;
+        for (std::size_t i = 0; i < r.size(); ++i) r[i] = record_[i].u64;
+        if (decoder_.feed(r) != interp::wire::Decoder::Item::Command) return;
+        const interp::Canon& c = decoder_.command();
+        if (const auto* m = std::get_if<interp::canon::Message>(&c.cmd)) {
+            messages_.push_back(fmt::format("{}:{}: message: {}", c.loc.file, c.loc.line,
+                                            m->text.empty() ? "(cleared)" : m->text));
+        } else if (const auto* w = std::get_if<interp::canon::Warning>(&c.cmd)) {
+            clear_bar();
+            fmt::print(stderr, "{}:{}:{}: warning: {}\n", c.loc.file, c.loc.line, c.loc.col,
+                       w->text);
+        }
+    }
+    void clear_bar() {
+        if (!tty_) return;
+        fmt::print("\r\x1b[K");
+        std::fflush(stdout);
+    }
+
+    hal::Ring* ring_ = nullptr;
+    std::optional<Probe> count_;
+    bool tty_;
+    std::vector<hal::Value> record_;
+    interp::wire::Decoder decoder_;
+    std::deque<std::string> messages_;  // decoded, not yet reached
+    double shown_ = 0;
+};
+
 // The trace: a header row, then one row per sample: t, line, axis commands, joint feedback,
 // path velocity.
 class Trace {
@@ -506,7 +569,7 @@ bool operator_pressed_enter() {
 // servo period, or a poll interval of wall time) and returns the time since start.
 LoopResult watch(Session& session, const MachinePins& pins, const RunOptions& o,
                  const std::function<void(Sample&)>& next, Stats& stats, Progress& progress,
-                 Trace* trace, Preview* preview, const StopRequest& stop) {
+                 OperatorTexts& texts, Trace* trace, Preview* preview, const StopRequest& stop) {
     LoopResult r;
     Sample& s = r.last;
     bool ever_enabled = false;
@@ -519,6 +582,7 @@ LoopResult watch(Session& session, const MachinePins& pins, const RunOptions& o,
         if (preview) preview->add(xyz_of(pins, s), s.line);
         stats.add(s);
         progress.update(s.t_s, s.line);
+        texts.poll();
         if (abort_at_s) {
             if (s.in_position || s.t_s > *abort_at_s + kAbortGraceS) return r;
             continue;
@@ -823,9 +887,10 @@ int run_session(const RunOptions& o, const Config& c, Session& session, const St
 
     Stats stats(pins.letters, pins.ferror.size(), o.sim_clock || stream, c.period_s);
     Progress progress(c.program_lines, ::isatty(STDOUT_FILENO) == 1);
+    OperatorTexts texts(session.runtime, ::isatty(STDOUT_FILENO) == 1);
     const LoopResult r =
         watch(session, pins, o, make_source(session, pins, o, c.period_s, stream.get()), stats,
-              progress, trace.get(), preview.get(), stop);
+              progress, texts, trace.get(), preview.get(), stop);
     progress.finish(r.last.t_s, r.outcome == Outcome::Finished);
     session.exec({"stop"});  // motion prints a late planner error here
     if (stream && stream->lost_cycles() > 0)

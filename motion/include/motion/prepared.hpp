@@ -32,6 +32,10 @@ enum class ActionKind : std::uint8_t {
     SpindleAtSpeed,
     // G904: the sampler runs PreparedSegment::probe; flag = feed override fixed at 100 % (G903).
     ConditionalMove,
+    Message,       // value = number of the M801 message reached (see PreparedSegment::message)
+    MaskLimits,    // flag = limit switches masked (M802 P131072) / obeyed again (P131073)
+    HomeDone,      // M902: value = axis, number = its machine coordinate from here on, mm
+    SpindleClamp,  // flag = clamped (V5.4 M10) / released (M11)
 };
 
 struct Action {
@@ -64,6 +68,9 @@ struct PreparedSegment {
     // changes motion.digital-out-n in the period the sampler starts following this record.
     std::uint64_t dout_set = 0;
     std::uint64_t dout_clear = 0;
+    // > 0: the program's M801 messages up to this number have been reached when the sampler
+    // starts following this record (like the outputs: shown without stopping the path).
+    std::uint32_t message = 0;
     // The planner copies PathSegment::move_id to every record made from that segment (the
     // blend into it included), so the feeder can find where a move begins.
     std::uint32_t move_id = 0;

@@ -106,6 +106,7 @@ class Sampler {
     struct SyncOutputs {
         std::uint64_t set = 0;
         std::uint64_t clear = 0;
+        std::uint32_t message = 0;  // highest PreparedSegment::message entered; 0: none
     };
     SyncOutputs take_sync_outputs() noexcept;
 
