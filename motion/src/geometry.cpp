@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -17,15 +18,20 @@ double norm(const AxisArray& v) {
     return std::sqrt(s);
 }
 
+// Each evaluator computes the derivatives up to Order (0 = position only, ... 3 = all); the
+// planner asks for positions and tangents far more often than the sampler asks for all of it.
+// Every expression is the same whatever the order, so the values do not depend on it.
+template <int Order>
 void eval_line(const Element& e, double s, CurvePoint& out) {
     for (int k = 0; k < kAxes; ++k) {
         out.p[k] = e.origin[k] + s * e.a[k];
-        out.d1[k] = e.a[k];
-        out.d2[k] = 0;
-        out.d3[k] = 0;
+        if constexpr (Order >= 1) out.d1[k] = e.a[k];
+        if constexpr (Order >= 2) out.d2[k] = 0;
+        if constexpr (Order >= 3) out.d3[k] = 0;
     }
 }
 
+template <int Order>
 void eval_arc(const Element& e, double s, CurvePoint& out) {
     double k1 = e.sweep_rad / e.length_mm;  // d theta / ds
     double th = e.theta0_rad + k1 * s;
@@ -35,12 +41,13 @@ void eval_arc(const Element& e, double s, CurvePoint& out) {
         double radial = cs * e.a[k] + sn * e.b[k];
         double tang = -sn * e.a[k] + cs * e.b[k];
         out.p[k] = e.origin[k] + r * radial + f * e.c[k];
-        out.d1[k] = r * k1 * tang + e.c[k] / e.length_mm;
-        out.d2[k] = -r * k1 * k1 * radial;
-        out.d3[k] = -r * k1 * k1 * k1 * tang;
+        if constexpr (Order >= 1) out.d1[k] = r * k1 * tang + e.c[k] / e.length_mm;
+        if constexpr (Order >= 2) out.d2[k] = -r * k1 * k1 * radial;
+        if constexpr (Order >= 3) out.d3[k] = -r * k1 * k1 * k1 * tang;
     }
 }
 
+template <int Order>
 void eval_blend(const Element& e, double s, CurvePoint& out) {
     double two_l = e.length_mm;
     double u = s / two_l;
@@ -50,12 +57,13 @@ void eval_blend(const Element& e, double s, CurvePoint& out) {
     double ddsigma = (6 - 12 * u) / (two_l * two_l);
     for (int k = 0; k < kAxes; ++k) {
         out.p[k] = e.origin[k] + two_l * (u * e.a[k] + integral * e.b[k]);
-        out.d1[k] = e.a[k] + sigma * e.b[k];
-        out.d2[k] = dsigma * e.b[k];
-        out.d3[k] = ddsigma * e.b[k];
+        if constexpr (Order >= 1) out.d1[k] = e.a[k] + sigma * e.b[k];
+        if constexpr (Order >= 2) out.d2[k] = dsigma * e.b[k];
+        if constexpr (Order >= 3) out.d3[k] = ddsigma * e.b[k];
     }
 }
 
+template <int Order>
 void eval_bezier(const Element& e, double s, CurvePoint& out) {
     double L = e.length_mm;
     double u = s / L, w = 1 - u;
@@ -64,31 +72,46 @@ void eval_bezier(const Element& e, double s, CurvePoint& out) {
         double p0 = e.origin[k], p1 = e.a[k], p2 = e.b[k], p3 = e.end[k];
         double d0 = p1 - p0, d1 = p2 - p1, d2 = p3 - p2;
         out.p[k] = b0 * p0 + b1 * p1 + b2 * p2 + b3 * p3;
-        out.d1[k] = 3 * (w * w * d0 + 2 * u * w * d1 + u * u * d2) / L;
-        out.d2[k] = 6 * (w * (d1 - d0) + u * (d2 - d1)) / (L * L);
-        out.d3[k] = 6 * (d2 - 2 * d1 + d0) / (L * L * L);
+        if constexpr (Order >= 1) out.d1[k] = 3 * (w * w * d0 + 2 * u * w * d1 + u * u * d2) / L;
+        if constexpr (Order >= 2) out.d2[k] = 6 * (w * (d1 - d0) + u * (d2 - d1)) / (L * L);
+        if constexpr (Order >= 3) out.d3[k] = 6 * (d2 - 2 * d1 + d0) / (L * L * L);
     }
+}
+
+template <int Order>
+void evaluate_to(const Element& e, double s, CurvePoint& out) noexcept {
+    s = std::clamp(s, 0.0, e.length_mm);
+    switch (e.kind) {
+        case ElementKind::Line:
+            eval_line<Order>(e, s, out);
+            break;
+        case ElementKind::Arc:
+            eval_arc<Order>(e, s, out);
+            break;
+        case ElementKind::Blend:
+            eval_blend<Order>(e, s, out);
+            break;
+        case ElementKind::Bezier:
+            eval_bezier<Order>(e, s, out);
+            break;
+    }
+    if (s >= e.length_mm) out.p = e.end;  // the programmed end point, free of rounding
 }
 
 }  // namespace
 
 void evaluate(const Element& e, double s, CurvePoint& out) noexcept {
-    s = std::clamp(s, 0.0, e.length_mm);
-    switch (e.kind) {
-        case ElementKind::Line:
-            eval_line(e, s, out);
-            break;
-        case ElementKind::Arc:
-            eval_arc(e, s, out);
-            break;
-        case ElementKind::Blend:
-            eval_blend(e, s, out);
-            break;
-        case ElementKind::Bezier:
-            eval_bezier(e, s, out);
-            break;
-    }
-    if (s >= e.length_mm) out.p = e.end;  // the programmed end point, free of rounding
+    evaluate_to<3>(e, s, out);
+}
+
+void evaluate_to_d2(const Element& e, double s_mm, CurvePoint& out) noexcept {
+    evaluate_to<2>(e, s_mm, out);
+}
+
+AxisArray point_at(const Element& e, double s_mm) noexcept {
+    CurvePoint cp;
+    evaluate_to<0>(e, s_mm, cp);
+    return cp.p;
 }
 
 ElementBounds bounds(const Element& e) noexcept {
@@ -141,6 +164,22 @@ ElementBounds bounds(const Element& e) noexcept {
             break;
         }
     }
+    // g1 is the sum (arcs) or the value (others) of tangential_in_plane and linear, so these
+    // three cover all five bounds. The entry past the last listed axis is overwritten freely.
+    std::uint64_t bits[kAxes];
+    for (int k = 0; k < kAxes; ++k) {
+        std::uint64_t x, y, z;
+        std::memcpy(&x, &b.g1[k], 8);
+        std::memcpy(&y, &b.g2[k], 8);
+        std::memcpy(&z, &b.g3[k], 8);
+        bits[k] = x | y | z;
+    }
+    int n = 0;
+    for (int k = 0; k < kAxes; ++k) {
+        b.axes[n] = static_cast<std::uint8_t>(k);
+        n += bits[k] != 0;
+    }
+    b.axis_count = n;
     return b;
 }
 
@@ -260,11 +299,7 @@ Element trim_arc(const Element& arc, double from, double to) noexcept {
     Element e = arc;
     double len = arc.length_mm;
     double keep = std::max(0.0, len - from - to);
-    if (to > 0) {
-        CurvePoint cp;
-        evaluate(arc, len - to, cp);
-        e.end = cp.p;
-    }
+    if (to > 0) e.end = point_at(arc, len - to);
     // origin holds the centre in the plane and the start's values off it (c is zero in-plane).
     double f0 = from / len;
     for (int k = 0; k < kAxes; ++k) e.origin[k] = arc.origin[k] + f0 * arc.c[k];
@@ -277,13 +312,13 @@ Element trim_arc(const Element& arc, double from, double to) noexcept {
 
 EndDerivs start_derivs(const Element& e) noexcept {
     CurvePoint cp;
-    evaluate(e, 0, cp);
+    evaluate_to<2>(e, 0, cp);
     return {cp.d1, cp.d2};
 }
 
 EndDerivs end_derivs(const Element& e) noexcept {
     CurvePoint cp;
-    evaluate(e, e.length_mm, cp);
+    evaluate_to<2>(e, e.length_mm, cp);
     return {cp.d1, cp.d2};
 }
 
@@ -370,13 +405,7 @@ void add_chords(CornerPath& path, const Element& e, double s0, double s1, double
     }
     auto point = [&](int i, AxisArray& out) {
         double s = i == n ? s1 : s0 + (s1 - s0) * i / n;
-        if (s == known_s) {
-            out = known;
-            return;
-        }
-        CurvePoint cp;
-        evaluate(e, s, cp);
-        out = cp.p;
+        out = s == known_s ? known : point_at(e, s);
     };
     AxisArray a, b;
     point(0, a);

@@ -24,21 +24,27 @@ constexpr double kJerkCrossShareArc = 0.3;
 constexpr double kJerkCubicShareBlend = 0.7;
 constexpr double kJerkCrossShareBlend = 0.15;
 
+// The loops below run over ElementBounds::axes only: every other axis has zero bounds and would
+// add nothing to any minimum.
+
 bool is_arc(const Element& e) {
     return e.kind == ElementKind::Arc;
 }
 
 double speed_cap(const Element& e, const ElementBounds& b, const AxisLimits& lim, double feed,
                  const LimitShares& share) {
-    bool jerk =
-        std::any_of(lim.jerk_mm_s3.begin(), lim.jerk_mm_s3.end(), [](double j) { return j > 0; });
+    auto jerk = [&] {  // asked only for arcs: it reads all nine axes
+        return std::any_of(lim.jerk_mm_s3.begin(), lim.jerk_mm_s3.end(),
+                           [](double j) { return j > 0; });
+    };
     double centripetal = !is_arc(e) ? kCentripetalShareBlend
-                         : jerk     ? kCentripetalShareArc
+                         : jerk()   ? kCentripetalShareArc
                                     : kCentripetalShareArcNoJerk;
     double cubic = is_arc(e) ? kJerkCubicShareArc : kJerkCubicShareBlend;
     // Smallest allowed v, v^2 and v^3 over the axes first, then one root of each.
     double v1 = feed > 0 ? feed : kInf, v2 = kInf, v3 = kInf;
-    for (int k = 0; k < kAxes; ++k) {
+    for (int i = 0; i < b.axis_count; ++i) {
+        const int k = b.axes[i];
         if (b.g1[k] > 0) v1 = std::min(v1, lim.vel_mm_s[k] / b.g1[k]);
         if (b.g2[k] > 0) v2 = std::min(v2, centripetal * share.acc * lim.acc_mm_s2[k] / b.g2[k]);
         if (b.g3[k] > 0 && lim.jerk_mm_s3[k] > 0)
@@ -64,7 +70,8 @@ double arc_axis_acc(double t, double l, double n, double m) {
 double tangential_acc(const Element& e, const ElementBounds& b, const AxisLimits& lim, double v,
                       const LimitShares& share) {
     double a = kInf;
-    for (int k = 0; k < kAxes; ++k) {
+    for (int i = 0; i < b.axis_count; ++i) {
+        const int k = b.axes[i];
         double m = share.acc * lim.acc_mm_s2[k];
         double n = v * v * b.g2[k];
         if (is_arc(e)) {
@@ -84,7 +91,8 @@ ElementLimits element_limits(const Element& e, const ElementBounds& b, const Axi
     double v = speed_cap(e, b, lim, feed, share);
     double a = tangential_acc(e, b, lim, v, share);
     double j = kInf;
-    for (int k = 0; k < kAxes; ++k) {
+    for (int i = 0; i < b.axis_count; ++i) {
+        const int k = b.axes[i];
         if (lim.jerk_mm_s3[k] <= 0) continue;
         double m = share.jerk * lim.jerk_mm_s3[k];
         double cross = is_arc(e) ? kJerkCrossShareArc : kJerkCrossShareBlend;
@@ -102,7 +110,8 @@ double rate_cap(const ElementBounds& b, const AxisLimits& lim, double v, double 
     // r scales velocity by r, acceleration by r^2 and jerk by r^3: collect the smallest
     // allowed r, r^2 and r^3 first, then take one root of each.
     double r1 = max_rate, r2 = kInf, r3 = kInf;
-    for (int k = 0; k < kAxes; ++k) {
+    for (int i = 0; i < b.axis_count; ++i) {
+        const int k = b.axes[i];
         if (b.g1[k] == 0 && b.g2[k] == 0) continue;
         double vk = v * b.g1[k];
         double ak = a * b.g1[k] + v * v * b.g2[k];

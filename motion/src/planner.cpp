@@ -256,8 +256,8 @@ Planner::Junction Planner::bezier_corner(const Piece& p, const Piece& next, doub
     const CornerPath path = corner_path(p.geom, reach, next.geom, reach, allowed_mm);
     for (int attempt = 0; attempt < kBlendAttempts && l > kMinLength_mm; ++attempt, l *= 0.7) {
         CurvePoint a, b;
-        evaluate(p.geom, L1 - l, a);
-        evaluate(next.geom, l, b);
+        evaluate_to_d2(p.geom, L1 - l, a);
+        evaluate_to_d2(next.geom, l, b);
         std::optional<BezierPoints> ctrl = corner_bezier_points(a.p, a.d1, b.p, b.d1, l);
         if (!ctrl || !bezier_within(*ctrl, path, allowed_mm)) continue;
         Junction jn{kInf, false, l, Blend::Curve};

@@ -5,7 +5,9 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <map>
 #include <stdexcept>
@@ -120,27 +122,85 @@ double thread_cpu_s() {
     return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
+// One planning pass over the program, as the throughput counts it. Not inlined so that a
+// profiler can count one pass: `valgrind --tool=callgrind --toggle-collect='*plan_pass*'`
+// gives instructions per pass (docs/benchmarks.md, planning throughput).
+[[gnu::noinline]] void plan_pass(const PlannerConfig& cfg, const bench::BenchProgram& prog) {
+    PreparedSegment rec;
+    Planner planner(cfg, prog.start_mm);
+    for (const PathSegment& seg : prog.segments) {
+        planner.push(seg);
+        while (planner.pop(rec)) {
+        }
+    }
+    planner.finish();
+    while (planner.pop(rec)) {
+    }
+}
+
 // Segments planned per second of this thread's CPU time (the machine may be shared, so wall
 // time would measure the neighbours too).
 double throughput_seg_s(const PlannerConfig& cfg, const bench::BenchProgram& prog, double min_s) {
     double t0 = thread_cpu_s();
     long segs = 0;
     double elapsed = 0;
-    PreparedSegment rec;
     do {
-        Planner planner(cfg, prog.start_mm);
-        for (const PathSegment& seg : prog.segments) {
-            planner.push(seg);
-            while (planner.pop(rec)) {
-            }
-        }
-        planner.finish();
-        while (planner.pop(rec)) {
-        }
+        plan_pass(cfg, prog);
         segs += long(prog.segments.size());
         elapsed = thread_cpu_s() - t0;
     } while (elapsed < min_s);
     return segs / elapsed;
+}
+
+// FNV-1a over every planned value of every record, bit for bit (so -0 and +0 differ): a change
+// meant to make the planner faster without changing a plan must leave it unchanged.
+class PlanDigest {
+  public:
+    void add(const PreparedSegment& r) {
+        const Element& g = r.geom;
+        add_bits(static_cast<std::uint64_t>(g.kind));
+        add(g.length_mm);
+        for (const AxisArray* a : {&g.origin, &g.a, &g.b, &g.c, &g.end})
+            for (double x : *a) add(x);
+        add(g.radius_mm), add(g.theta0_rad), add(g.sweep_rad);
+        const Profile1D& p = r.profile;
+        add_bits(p.count);
+        for (int i = 0; i < p.count; ++i) {
+            const ProfilePhase& ph = p.phases[i];
+            add(ph.t0_s), add(ph.s0_mm), add(ph.v0_mm_s), add(ph.a0_mm_s2), add(ph.j_mm_s3);
+            add(r.phase_rate_cap[i]);
+        }
+        add(p.duration_s), add(p.peak_v_mm_s), add(p.peak_a_mm_s2), add(p.peak_j_mm_s3);
+        add_bits(static_cast<std::uint32_t>(r.line)), add_bits(r.seq), add_bits(r.move_id);
+        add_bits(r.rapid), add_bits(r.program_end);
+    }
+    std::uint64_t value() const { return h_; }
+
+  private:
+    void add(double x) {
+        std::uint64_t bits;
+        std::memcpy(&bits, &x, sizeof bits);
+        add_bits(bits);
+    }
+    void add_bits(std::uint64_t v) {
+        for (int i = 0; i < 8; ++i, v >>= 8) h_ = (h_ ^ (v & 0xff)) * 0x100000001b3ULL;
+    }
+    std::uint64_t h_ = 0xcbf29ce484222325ULL;
+};
+
+int print_plan_digests(const Settings& s, const std::vector<std::string>& programs,
+                       const std::vector<double>& jerks) {
+    fmt::print("program,jerk_mm_s3,records,digest\n");
+    for (const std::string& program : programs) {
+        bench::BenchProgram prog = bench::read_program(program, s.tolerance_mm);
+        for (double j : jerks) {
+            PlanDigest d;
+            std::vector<PreparedSegment> recs = bench::plan_all(config_for(s, j), prog);
+            for (const PreparedSegment& r : recs) d.add(r);
+            fmt::print("{},{:g},{},{:016x}\n", program, j, recs.size(), d.value());
+        }
+    }
+    return 0;
 }
 
 struct Row {
@@ -255,6 +315,10 @@ int main(int argc, char** argv) {
     app.add_option("--excess", excess, "list the N lines with the most time over their bound");
     app.add_option("--min-cpu", min_cpu_s, "CPU seconds to spend measuring each throughput");
     app.add_flag("--smoke", smoke, "one quick pass (jerk unlimited, no throughput), for ctest");
+    bool digest = false;
+    app.add_flag("--plan-digest", digest,
+                 "print a digest of every planned record (bit for bit) per program and jerk, "
+                 "then exit: a change that only makes planning faster must leave it unchanged");
     std::string trace_out, trace_check;
     double trace_quantum_mm = 1e-6;
     app.add_option("--trace-out", trace_out,
@@ -270,6 +334,7 @@ int main(int argc, char** argv) {
     if (jerks.empty() || smoke) jerks = {0};
 
     try {
+        if (digest) return print_plan_digests(s, programs, jerks);
         if (!trace_check.empty())
             return print_trace_check(s, programs.front(), trace_check, trace_quantum_mm);
         if (csv)

@@ -54,14 +54,23 @@ struct CurvePoint {
 
 // Realtime-safe: noexcept, no allocation, constant time.
 void evaluate(const Element& e, double s_mm, CurvePoint& out) noexcept;
+// The same values as evaluate() for what they set: p, d1 and d2 only (d3 is left as it was),
+// or the position only. For the planner, which needs no more at most of its points.
+void evaluate_to_d2(const Element& e, double s_mm, CurvePoint& out) noexcept;
+AxisArray point_at(const Element& e, double s_mm) noexcept;
 
 // Per-axis bounds over the whole element: |p'_k| <= g1[k], |p''_k| <= g2[k], |p'''_k| <= g3[k].
 // For arcs, `tangential_in_plane[k]` and `linear[k]` split g1 so that the planner can use the
 // exact (rotating-vector) combination of tangential and centripetal acceleration.
 // bounds() sets every member (none is cleared first: it runs twice per planned element).
+// `axes` lists, in increasing order, the first `axis_count` axes the element may move: every
+// bound of any other axis is 0, so a loop over the axes that skips zero bounds can run over
+// these only (most programs move 2 or 3 of the 9 axes).
 struct ElementBounds {
     AxisArray g1, g2, g3;
     AxisArray tangential_in_plane, linear;
+    std::array<std::uint8_t, kAxes> axes;
+    int axis_count;
 };
 ElementBounds bounds(const Element& e) noexcept;
 
