@@ -6,6 +6,7 @@
 // operator, a function name or IF) from one that opens a comment, and to stop at ';' or a '
 // comment. Letter runs are kept whole ("G", "ABS", "PLC"); the block parser decides whether a
 // run is an address letter, a keyword or a function name.
+#include <array>
 #include <cstdint>
 #include <string_view>
 #include <vector>
@@ -59,6 +60,22 @@ struct Token {
     double number = 0.0;        // value of a Number
 };
 
+// One address word of a plain line (see Lexer::lex_plain): the letter as written, its column,
+// the value with its sign applied, and whether the literal had no decimal point.
+struct PlainWord {
+    char letter = 0;
+    bool integer_literal = false;
+    int col = 0;
+    double value = 0.0;
+};
+
+// The words of a plain line, in written order.
+struct PlainLine {
+    static constexpr int kMaxWords = 32;
+    std::array<PlainWord, kMaxWords> words;
+    int count = 0;
+};
+
 // Display form of an operator, for messages.
 std::string_view op_text(Op op);
 
@@ -71,6 +88,16 @@ class Lexer {
     // lexed as if it followed '=' (a leading '(' opens a sub-expression, not a comment).
     void lex(std::string_view line, const SourceLoc& loc, std::vector<Token>& out,
              bool expression_start = false) const;
+
+    // The fast path for the lines CAM output is made of: only address words, each a single
+    // letter and a literal with an optional sign ("G3 Y0 I-10 J0"), separated by
+    // spaces or nothing. Fills `out` and returns true for such a line; returns false (leaving
+    // `out` unspecified) for anything else — comments, expressions, keywords, a sign apart from
+    // its number, any byte it does not expect — which then goes through lex() and the block
+    // parser's general path. It never throws: the general path reports every error, so both
+    // paths must agree on every line lex_plain accepts (tests/interp_front/test_plain_line.cpp
+    // checks that on random lines).
+    bool lex_plain(std::string_view line, PlainLine& out) const;
 
   private:
     const Dialect* dialect_;

@@ -44,6 +44,8 @@ class BlockParser {
     }
 
     // Throws Error (file:line:col) on any syntax or evaluation error. `out` is reset first.
+    // A line of plain address words (Lexer::lex_plain) skips the tokens and the token walk; it
+    // gets the same block and the same errors as through the general path.
     void parse(std::string_view line, const SourceLoc& loc, ParsedLine& out);
 
   private:
@@ -61,6 +63,7 @@ class BlockParser {
     Variables& vars_;
     MachineQuery& machine_;
     std::vector<Token> tokens_;
+    PlainLine plain_;  // the words of a line lex_plain accepted
 };
 
 }  // namespace interp

@@ -219,6 +219,57 @@ std::string describe_byte(char c) {
 
 }  // namespace
 
+bool Lexer::lex_plain(std::string_view s, PlainLine& out) const {
+    out.count = 0;
+    const char* const begin = s.data();
+    const char* const end = begin + s.size();
+    const char* p = begin;
+    for (;;) {
+        while (p != end && char_class(*p) == CharClass::Space) ++p;
+        if (p == end) return true;
+        // A word starts with one letter; 'O' (labels) and 'P' (P"name") have forms of their own.
+        const char letter = *p;
+        if (char_class(letter) != CharClass::Letter || to_upper(letter) == 'O') return false;
+        const int col = static_cast<int>(p - begin) + 1;
+        ++p;
+        while (p != end && char_class(*p) == CharClass::Space) ++p;
+        if (p == end) return false;
+        double sign = 1.0;
+        bool has_sign = false;
+        if (*p == '-' || *p == '+') {
+            has_sign = true;
+            sign = *p == '-' ? -1.0 : 1.0;
+            ++p;
+            if (p == end) return false;
+        }
+        // A literal follows at once: a letter run ("GX"), '=', a space after the sign, … are the
+        // general path's (keywords, expressions, errors).
+        if (!is_digit(*p) && !(*p == '.' && p + 1 != end && is_digit(p[1]))) return false;
+        // scan_number's fast case, inline; longer literals are left to it (general path).
+        std::uint64_t mantissa = 0;
+        const char* const digits_start = p;
+        p = scan_digits(p, end, mantissa);
+        int frac_digits = 0;
+        const bool has_point = p != end && *p == '.';
+        if (has_point) {
+            const char* const frac = p + 1;
+            p = scan_digits(frac, end, mantissa);
+            frac_digits = static_cast<int>(p - frac);
+        }
+        if (p - digits_start - (has_point ? 1 : 0) > 15 || out.count == PlainLine::kMaxWords)
+            return false;
+        const double number = frac_digits == 0
+                                  ? static_cast<double>(mantissa)
+                                  : static_cast<double>(mantissa) / kPow10[frac_digits];
+        PlainWord& w = out.words[static_cast<std::size_t>(out.count++)];
+        w.letter = letter;
+        w.col = col;
+        w.integer_literal = !has_point;
+        // As the block parser computes a signed literal, so both paths give the same bits.
+        w.value = has_sign ? sign * number : number;
+    }
+}
+
 void Lexer::lex(std::string_view s, const SourceLoc& loc, std::vector<Token>& out,
                 bool expression_start) const {
     out.clear();

@@ -54,11 +54,69 @@ int to_int32(double v, const SourceLoc& loc, std::string_view what) {
     return static_cast<int>(i);
 }
 
+// Stores the value of address letter L (upper case) written at column `col` of the line at `loc`;
+// throws what a bad or repeated word deserves. Shared by the general path and the plain-line fast
+// path, so both store and reject alike.
+void store_word(ParsedLine& out, const SourceLoc& loc, char L, int col, double v,
+                bool integer_literal) {
+    Block& b = out.block;
+    const auto at = [&] { return SourceLoc{loc.file, loc.line, col}; };
+    switch (L) {
+        case 'G': {
+            const double scaled = v * 10.0;
+            const double r = std::nearbyint(scaled);
+            if (std::fabs(scaled - r) > 1e-6) {
+                throw Error(at(), "G code G" + fmt::format("{}", v) + " has more than one decimal");
+            }
+            if (r < 0 || r > 1e7) throw Error(at(), "G code out of range");
+            if (!b.g.push_back(static_cast<int>(r)) || !b.g_col.push_back(col)) {
+                throw Error(at(), "too many G codes in one block");
+            }
+            return;
+        }
+        case 'M': {
+            const int m = to_int32(v, at(), "M code");
+            if (m < 0) throw Error(at(), "M code must not be negative");
+            if (!b.m.push_back(m) || !b.m_col.push_back(col)) {
+                throw Error(at(), "too many M codes in one block");
+            }
+            return;
+        }
+        case 'N': {
+            if (b.n) throw Error(at(), "a block can have only one sequence number N");
+            const std::int64_t n = to_integer(v, at(), "sequence number N");
+            if (n < 0) throw Error(at(), "sequence number N must not be negative");
+            b.n = n;
+            return;
+        }
+        default: {
+            const int i = letter_index(L);
+            if (b.words[i] || (L == 'P' && out.p_name)) {
+                throw Error(at(), std::string("word ") + L + " appears twice in one block");
+            }
+            b.words[i] = v;
+            b.word_col[i] = col;
+            out.letters_set |= 1u << i;
+            if (integer_literal) b.integer_literal_mask |= 1u << i;
+            return;
+        }
+    }
+}
+
 }  // namespace
 
 void BlockParser::parse(std::string_view line, const SourceLoc& loc, ParsedLine& out) {
     out.reset();
     out.block.loc = loc;
+    // Most lines of a CAM program are plain words: they skip the tokens and the token walk.
+    if (lexer_.lex_plain(line, plain_)) {
+        if (plain_.count > 0) out.block.loc.col = plain_.words[0].col;
+        for (int i = 0; i < plain_.count; ++i) {
+            const PlainWord& w = plain_.words[static_cast<std::size_t>(i)];
+            store_word(out, loc, to_upper(w.letter), w.col, w.value, w.integer_literal);
+        }
+        return;
+    }
     lexer_.lex(line, loc, tokens_);
     Ctx c{TokenCursor{&tokens_, 0}, ExprEvaluator(*dialect_, vars_, machine_, loc.file, loc.line),
           out, loc};
@@ -182,47 +240,7 @@ void BlockParser::parse_letter(Ctx& c, const Token& letter) {
     bool integer_literal = false;
     const double v = parse_value(c, letter, &integer_literal);
     if (c.dry) return;
-    switch (L) {
-        case 'G': {
-            const double scaled = v * 10.0;
-            const double r = std::nearbyint(scaled);
-            if (std::fabs(scaled - r) > 1e-6) {
-                throw Error(c.at(letter),
-                            "G code G" + fmt::format("{}", v) + " has more than one decimal");
-            }
-            if (r < 0 || r > 1e7) throw Error(c.at(letter), "G code out of range");
-            if (!b.g.push_back(static_cast<int>(r)) || !b.g_col.push_back(letter.col)) {
-                throw Error(c.at(letter), "too many G codes in one block");
-            }
-            return;
-        }
-        case 'M': {
-            const int m = to_int32(v, c.at(letter), "M code");
-            if (m < 0) throw Error(c.at(letter), "M code must not be negative");
-            if (!b.m.push_back(m) || !b.m_col.push_back(letter.col)) {
-                throw Error(c.at(letter), "too many M codes in one block");
-            }
-            return;
-        }
-        case 'N': {
-            if (b.n) throw Error(c.at(letter), "a block can have only one sequence number N");
-            const std::int64_t n = to_integer(v, c.at(letter), "sequence number N");
-            if (n < 0) throw Error(c.at(letter), "sequence number N must not be negative");
-            b.n = n;
-            return;
-        }
-        default: {
-            const int i = letter_index(L);
-            if (b.words[i] || (L == 'P' && c.out.p_name)) {
-                throw Error(c.at(letter), std::string("word ") + L + " appears twice in one block");
-            }
-            b.words[i] = v;
-            b.word_col[i] = letter.col;
-            c.out.letters_set |= 1u << i;
-            if (integer_literal) b.integer_literal_mask |= 1u << i;
-            return;
-        }
-    }
+    store_word(c.out, c.loc, L, letter.col, v, integer_literal);
 }
 
 int BlockParser::parse_plc_address(Ctx& c, const Token& keyword) {
