@@ -16,12 +16,16 @@ struct ArcInput {
     std::optional<Eigen::Vector2d> centre;  // from I/J/K, absolute
     double tolerance_mm = 0.01;
     bool v54_small_radius_is_half_circle = false;  // ARC-10
+    // false: sweep_rad is left 0. The back end needs the sweep only for a V5.4 K-lead helix
+    // (ARC-9), and it costs an atan2, a tenth of an arc block's time.
+    bool want_sweep = true;
 };
 
 struct ArcResult {
     Eigen::Vector2d centre{0, 0};
     double radius_mm = 0;
     double sweep_rad = 0;  // always positive, in the direction of travel; 2π for a full circle
+                           // (0 when not wanted, see ArcInput::want_sweep)
 };
 
 // Empty string on success, else the error text.

@@ -46,7 +46,7 @@ std::string solve_r(const ArcInput& in, ArcResult& out) {
     const double side = (in.ccw ? 1.0 : -1.0) * (r_signed < 0 ? -1.0 : 1.0);
     out.centre = (in.start + in.end) / 2 + side * h * left;
     out.radius_mm = r;
-    out.sweep_rad = sweep_between(out.centre, in.start, in.end, in.ccw);
+    if (in.want_sweep) out.sweep_rad = sweep_between(out.centre, in.start, in.end, in.ccw);
     return {};
 }
 
@@ -62,6 +62,7 @@ std::string solve_centre(const ArcInput& in, ArcResult& out) {
             fmt_num(r0), fmt_num(r1), fmt_num(std::abs(r0 - r1)), fmt_num(in.tolerance_mm));
     out.centre = c;
     out.radius_mm = r0;
+    if (!in.want_sweep) return {};
     out.sweep_rad = (in.end - in.start).norm() < kSamePoint
                         ? 2 * std::numbers::pi
                         : sweep_between(c, in.start, in.end, in.ccw);

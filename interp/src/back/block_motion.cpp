@@ -130,12 +130,14 @@ void BlockRun::move_arc(bool ccw) {
         else
             in.centre = Eigen::Vector2d(ci, cj);
     }
+    // ARC-9 (V5.4): K is the lead of a multi-turn helix in G17 when it is not a centre word.
+    const bool k_lead = cfg_.v54_compat && st.motion.plane == Plane::XY && b_.has('K') && has_r;
+    in.want_sweep = k_lead;
     ArcResult r;
     if (std::string why = solve_arc(in, r); !why.empty()) fail(b_.loc, why);
 
-    // ARC-9 (V5.4): K is the lead of a multi-turn helix in G17 when it is not a centre word.
     int extra_turns = 0;
-    if (cfg_.v54_compat && st.motion.plane == Plane::XY && b_.has('K') && has_r) {
+    if (k_lead) {
         const double lead = std::abs(b_.get('K') * st.units.mm_per_unit);
         const double dz = std::abs(end[2] - start[2]);
         if (lead > 0)
