@@ -54,11 +54,9 @@ int to_int32(double v, const SourceLoc& loc, std::string_view what) {
     return static_cast<int>(i);
 }
 
-// Stores the value of address letter L (upper case) written at column `col` of the line at `loc`;
-// throws what a bad or repeated word deserves. Shared by the general path and the plain-line fast
-// path, so both store and reject alike.
-void store_word(ParsedLine& out, const SourceLoc& loc, char L, int col, double v,
-                bool integer_literal) {
+// store_word for G, M, N and for a letter already present (the repeat error).
+void store_coded_word(ParsedLine& out, const SourceLoc& loc, char L, int col, double v,
+                      bool integer_literal) {
     Block& b = out.block;
     const auto at = [&] { return SourceLoc{loc.file, loc.line, col}; };
     switch (L) {
@@ -101,6 +99,22 @@ void store_word(ParsedLine& out, const SourceLoc& loc, char L, int col, double v
             return;
         }
     }
+}
+
+// Stores the value of address letter L (upper case) written at column `col` of the line at `loc`;
+// throws what a bad or repeated word deserves. Shared by the general path and the plain-line fast
+// path, so both store and reject alike. The common case, a first X, Y, F…, is kept small enough
+// to inline.
+inline void store_word(ParsedLine& out, const SourceLoc& loc, char L, int col, double v,
+                       bool integer_literal) {
+    const int i = letter_index(L);
+    Block& b = out.block;
+    if (L == 'G' || L == 'M' || L == 'N' || b.words[i] || (L == 'P' && out.p_name))
+        return store_coded_word(out, loc, L, col, v, integer_literal);
+    b.words[i] = v;
+    b.word_col[i] = col;
+    out.letters_set |= 1u << i;
+    if (integer_literal) b.integer_literal_mask |= 1u << i;
 }
 
 }  // namespace
