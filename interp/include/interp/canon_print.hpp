@@ -70,7 +70,7 @@ class SummarySink final : public CanonSink {
     int moves() const { return moves_; }
 
   private:
-    void extend(const std::array<double, 3>& p);
+    void extend(double x, double y, double z);
     void line_to(const AxisVec& end, bool rapid);
     void arc(const canon::Arc& a);
 
