@@ -349,7 +349,7 @@ void BlockRun::run_hole_pattern() {
 // program keeps every hole before that stop.
 void BlockRun::begin_holes(cycles::BlockHoles&& b) {
     for (const std::string& w : b.warnings) emit(canon::Warning{w});
-    holes_ = std::move(b.holes);
+    holes_.emplace(std::move(b.holes));
     cycle_dir_at_start_ = st.spindle.dir;
     next_pending_hole();
     if (m(0) || m(1) || m(2) || m(30))
@@ -358,7 +358,7 @@ void BlockRun::begin_holes(cycles::BlockHoles&& b) {
 }
 
 bool BlockRun::next_pending_hole() {
-    if (!holes_.next(hole_steps_)) return false;
+    if (!holes_ || !holes_->next(hole_steps_)) return false;
     emit_cycle_steps(hole_steps_);
     return true;
 }

@@ -67,7 +67,7 @@ class BlockRun {
         : st(st), b_(b), cfg_(cfg), base_xf_(xf), base_settings_(settings), out_(out) {}
 
     void run();
-    bool has_pending_holes() const { return holes_.holes_done() < holes_.hole_count(); }
+    bool has_pending_holes() const { return holes_ && holes_->holes_done() < holes_->hole_count(); }
     /// Appends the next hole of the block's canned cycle to the output; false when none is left.
     bool next_pending_hole();
 
@@ -215,8 +215,10 @@ class BlockRun {
     std::optional<int> cycle_code_;   // G73..G89 or G80 written in this block
     const GInfo* axis_user_ = nullptr;
     unsigned groups_ = 0;
-    cycles::HoleRun holes_;                     // this block's canned-cycle holes, made lazily
-    std::vector<cycles::Step> hole_steps_;      // one hole's steps
+    // This block's canned-cycle holes, made lazily. Absent in most blocks: an empty HoleRun is a
+    // few hundred bytes to zero for every block.
+    std::optional<cycles::HoleRun> holes_;
+    std::vector<cycles::Step> hole_steps_;  // one hole's steps
     SpindleDir cycle_dir_at_start_ = SpindleDir::Stop;
 };
 
