@@ -37,7 +37,8 @@ double speed_cap(const Element& e, const ElementBounds& b, const AxisLimits& lim
         return std::any_of(lim.jerk_mm_s3.begin(), lim.jerk_mm_s3.end(),
                            [](double j) { return j > 0; });
     };
-    double centripetal = !is_arc(e) ? kCentripetalShareBlend
+    double blend = share.blend_centripetal > 0 ? share.blend_centripetal : kCentripetalShareBlend;
+    double centripetal = !is_arc(e) ? blend
                          : jerk()   ? kCentripetalShareArc
                                     : kCentripetalShareArcNoJerk;
     double cubic = is_arc(e) ? kJerkCubicShareArc : kJerkCubicShareBlend;
@@ -103,6 +104,15 @@ ElementLimits element_limits(const Element& e, const ElementBounds& b, const Axi
     out.tangent.acc_mm_s2 = a;
     out.tangent.jerk_mm_s3 = std::isfinite(j) ? j : 0;
     return out;
+}
+
+double parabola_cut_for_speed_mm(const AxisArray& dt_turn, double v_mm_s, const AxisLimits& lim,
+                                 const LimitShares& share) noexcept {
+    double blend = share.blend_centripetal > 0 ? share.blend_centripetal : kCentripetalShareBlend;
+    double worst = 0;  // max_k |dT_k| / (allowed acceleration of k)
+    for (int k = 0; k < kAxes; ++k)
+        worst = std::max(worst, std::fabs(dt_turn[k]) / (blend * share.acc * lim.acc_mm_s2[k]));
+    return v_mm_s * v_mm_s * worst / 2;
 }
 
 double rate_cap(const ElementBounds& b, const AxisLimits& lim, double v, double a, double j,

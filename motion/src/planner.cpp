@@ -36,9 +36,31 @@ constexpr double kMaxArcTrimShare = 0.45;
 constexpr double kDeviationReach = 2;
 constexpr double kDeviationMargin = 0.95;
 constexpr int kBlendAttempts = 12;
+// Without a jerk limit a corner blend is cut for this much more than the speed either move
+// allows at the corner. Between moves of one feed a longer cut costs nothing at the corner, and
+// the margin leaves the blend over half its acceleration for speed changes at that speed
+// (surface_3d: 9.74 s at 1.05, 9.64 s at 1.5). Between a rapid and a feed move (or two feeds)
+// the blend runs at the slower feed, so it is cut as short as will do (ex08: 84.110 s at 1.05,
+// 84.128 s at 1.5).
+constexpr double kCornerSpeedMargin = 1.5;
+constexpr double kMixedCornerSpeedMargin = 1.05;
+constexpr double kSpeedCutFloor = 1.0 / 16;
+// Share of the acceleration an isolated corner blend spends turning (see close_piece).
+constexpr double kIsolatedBlendCentripetal = 0.99;
+// The first shrink step, and after a later one that succeeded, this many bisections towards
+// the cut that failed.
+constexpr double kBlendFirstShrink = 0.97;
+constexpr int kBlendBisections = 3;
 // With a jerk limit a Bezier blend (curvature steps at its ends) is used only if its ends can
 // be passed at this share of the feed.
 constexpr double kJerkBlendMinFeedShare = 0.25;
+
+// The blend cut: what the geometry allows, shortened to what the corner speed needs, but not
+// below kSpeedCutFloor of the former: near-collinear corners need almost no cut, and a blend a
+// million times shorter than its coordinates gets second derivatives from rounding.
+double cut_for_speed(double l_geom_mm, double l_speed_mm) {
+    return std::min(l_geom_mm, std::max(l_speed_mm, kSpeedCutFloor * l_geom_mm));
+}
 
 bool finite_array(const AxisArray& a) {
     return std::all_of(a.begin(), a.end(), [](double x) { return std::isfinite(x); });
@@ -158,6 +180,24 @@ Planner::Junction Planner::classify(const Piece& p, const Piece& next) const {
     double feed =
         std::min(p.feed_mm_s > 0 ? p.feed_mm_s : kInf, next.feed_mm_s > 0 ? next.feed_mm_s : kInf);
     if (!std::isfinite(feed)) feed = *std::max_element(lim.vel_mm_s.begin(), lim.vel_mm_s.end());
+    // Without a jerk limit a blend cut longer than the corner speed needs buys nothing and
+    // takes length from the moves, which speed up and slow down faster than a blend (and, when
+    // one of them is a rapid, at the rapid's speed): cut only what passing at the speed either
+    // move allows there (with a margin) needs. The parabola's cap is the model; the Bezier blends
+    // with an arc turn a little harder, hence the margin.
+    double l_speed_mm = kInf;
+    if (!jerk_mode_) {
+        double pass_mm_s = std::min(p.feed_mm_s > 0 ? p.feed_mm_s : kInf,
+                                    next.feed_mm_s > 0 ? next.feed_mm_s : kInf);
+        for (int k = 0; k < kAxes; ++k) {
+            double t = std::max(std::fabs(pe.tangent[k]), std::fabs(ns.tangent[k]));
+            if (t > 0) pass_mm_s = std::min(pass_mm_s, lim.vel_mm_s[k] / t);
+        }
+        double margin =
+            p.feed_mm_s == next.feed_mm_s ? kCornerSpeedMargin : kMixedCornerSpeedMargin;
+        l_speed_mm =
+            parabola_cut_for_speed_mm(dt, margin * pass_mm_s, lim, {1 - reserve_, 1 - reserve_});
+    }
     bool lines = p.geom.kind == ElementKind::Line && next.geom.kind == ElementKind::Line;
     if (lines && p.tolerance_mm > 0) {
         double l = std::min(p.geom.length_mm, next.geom.length_mm) / 2;
@@ -168,7 +208,8 @@ Planner::Junction Planner::classify(const Piece& p, const Piece& next) const {
         // Without a jerk limit the parabola (the per-axis bang-bang corner) is the fastest;
         // its distance from the lines is (l / 4) sin(angle) (geometry.hpp).
         if (!jerk_mode_) {
-            l = std::min(l, p.tolerance_mm / (kParabolaDeviationPerL * sin_angle));
+            l = cut_for_speed(std::min(l, p.tolerance_mm / (kParabolaDeviationPerL * sin_angle)),
+                              l_speed_mm);
             if (l > kMinLength_mm) return {kInf, false, l, Blend::Parabola};
         } else {
             l = std::min(l, p.tolerance_mm / (kBlendDeviationPerL * sin_angle));
@@ -205,7 +246,7 @@ Planner::Junction Planner::classify(const Piece& p, const Piece& next) const {
     // Kinks with an arc (rounding in the program, or a real corner): a blend where passing
     // the kink would cost speed.
     if (cap < feed && p.tolerance_mm > 0 && sin_angle < kMaxArcBlendSin) {
-        Junction jn = bezier_corner(p, next, sin_angle, feed);
+        Junction jn = bezier_corner(p, next, sin_angle, feed, l_speed_mm);
         if (jn.blend_l_mm > 0) return jn;
     }
     if (cap < kKinkStopFraction * feed) return {0, false, 0};
@@ -244,38 +285,65 @@ Element trimmed(const Element& e, double from_mm, double to_mm) {
 }  // namespace
 
 Planner::Junction Planner::bezier_corner(const Piece& p, const Piece& next, double sin_angle,
-                                         double feed_mm_s) const {
+                                         double feed_mm_s, double l_speed_mm) const {
     const double tol = p.tolerance_mm;
     double l_max = std::min(max_trim_mm(p.geom, p.trim_start_mm), max_trim_mm(next.geom, 0));
     // For two lines the parabola's distance from them is exactly (l / 4) sin(angle); with an
     // arc that is the first guess, checked and shrunk below.
-    double l = std::min(l_max, tol / (kParabolaDeviationPerL * sin_angle));
+    const double allowed_mm = kDeviationMargin * tol;
+    double l = cut_for_speed(std::min(l_max, allowed_mm / (kParabolaDeviationPerL * sin_angle)),
+                             l_speed_mm);
     const double L1 = p.geom.length_mm;
     double reach = std::min(l_max, kDeviationReach * l);
-    const double allowed_mm = kDeviationMargin * tol;
     const CornerPath path = corner_path(p.geom, reach, next.geom, reach, allowed_mm);
-    for (int attempt = 0; attempt < kBlendAttempts && l > kMinLength_mm; ++attempt, l *= 0.7) {
-        CurvePoint a, b;
-        evaluate_to_d2(p.geom, L1 - l, a);
-        evaluate_to_d2(next.geom, l, b);
-        std::optional<BezierPoints> ctrl = corner_bezier_points(a.p, a.d1, b.p, b.d1, l);
-        if (!ctrl || !bezier_within(*ctrl, path, allowed_mm)) continue;
-        Junction jn{kInf, false, l, Blend::Curve};
-        jn.curve = make_bezier(ctrl->p0, ctrl->p1, ctrl->p2, ctrl->p3);
-        jn.curve_end_cap_mm_s = kInf;
-        if (!jerk_mode_) return jn;  // without a jerk limit curvature steps cost nothing
-        EndDerivs bs = start_derivs(jn.curve), be = end_derivs(jn.curve);
-        jn.cap_mm_s = curvature_step_cap(a.d2, bs.d2);
-        jn.rough = std::isfinite(jn.cap_mm_s);
-        jn.curve_end_cap_mm_s = curvature_step_cap(be.d2, b.d2);
-        jn.curve_end_rough = std::isfinite(jn.curve_end_cap_mm_s);
-        // The steps make the neighbours give up the junction share: only worth it when the
-        // corner can then be taken at a good part of the feed.
-        if (std::min(jn.cap_mm_s, jn.curve_end_cap_mm_s) < kJerkBlendMinFeedShare * feed_mm_s)
-            return {0, false, 0};
-        return jn;
+    struct Fit {
+        CurvePoint a, b;  // the blend's ends on the moves
+        BezierPoints ctrl;
+    };
+    auto fits = [&](double l_try, Fit& out) {
+        evaluate_to_d2(p.geom, L1 - l_try, out.a);
+        evaluate_to_d2(next.geom, l_try, out.b);
+        std::optional<BezierPoints> ctrl =
+            corner_bezier_points(out.a.p, out.a.d1, out.b.p, out.b.d1, l_try);
+        if (!ctrl || !bezier_within(*ctrl, path, allowed_mm)) return false;
+        out.ctrl = *ctrl;
+        return true;
+    };
+    // Shrink until a cut is proved, first by only 3 % (with an arc the largest provable cut is
+    // usually just under the two-line value: 0.974 of it on ex23's 90 degree arc-line corners),
+    // then by 0.7; after a 0.7 step bisect back towards the cut that failed, as the corner speed
+    // grows with the square root of the cut.
+    Fit fit, trial;
+    double l_fail = 0;  // a cut that was tried and not proved
+    bool found = false;
+    for (int attempt = 0; attempt < kBlendAttempts && l > kMinLength_mm; ++attempt) {
+        if ((found = fits(l, fit))) break;
+        l_fail = l;
+        l *= attempt == 0 ? kBlendFirstShrink : 0.7;
     }
-    return {0, false, 0};
+    if (!found) return {0, false, 0};
+    for (int i = 0; i < kBlendBisections && l_fail > l / kBlendFirstShrink * (1 + 1e-9); ++i) {
+        double mid = std::sqrt(l * l_fail);
+        if (fits(mid, trial))
+            l = mid, fit = trial;
+        else
+            l_fail = mid;
+    }
+    const CurvePoint &a = fit.a, &b = fit.b;
+    Junction jn{kInf, false, l, Blend::Curve};
+    jn.curve = make_bezier(fit.ctrl.p0, fit.ctrl.p1, fit.ctrl.p2, fit.ctrl.p3);
+    jn.curve_end_cap_mm_s = kInf;
+    if (!jerk_mode_) return jn;  // without a jerk limit curvature steps cost nothing
+    EndDerivs bs = start_derivs(jn.curve), be = end_derivs(jn.curve);
+    jn.cap_mm_s = curvature_step_cap(a.d2, bs.d2);
+    jn.rough = std::isfinite(jn.cap_mm_s);
+    jn.curve_end_cap_mm_s = curvature_step_cap(be.d2, b.d2);
+    jn.curve_end_rough = std::isfinite(jn.curve_end_cap_mm_s);
+    // The steps make the neighbours give up the junction share: only worth it when the
+    // corner can then be taken at a good part of the feed.
+    if (std::min(jn.cap_mm_s, jn.curve_end_cap_mm_s) < kJerkBlendMinFeedShare * feed_mm_s)
+        return {0, false, 0};
+    return jn;
 }
 
 void Planner::close_piece(Piece& p, Piece* next) {
@@ -288,16 +356,23 @@ void Planner::close_piece(Piece& p, Piece* next) {
     double f1 = p.feed_mm_s, f2 = next->feed_mm_s;
     double feed = f1 > 0 && f2 > 0 ? std::min(f1, f2) : std::max(f1, f2);
     const bool rapid = p.rapid && next->rapid;  // blends between two rapids are rapid too
+    // A blend between moves that keep at least its own length on either side is passed at one
+    // speed: the moves do the speeding up and slowing down, faster than a blend can, so without
+    // a jerk limit nearly all its acceleration goes to turning. In a chain of short moves the
+    // blends must change speed themselves and keep the default share.
+    double l = jn.blend_l_mm;
+    bool isolated = !jerk_mode_ && l > 0 && e.length_mm >= l && next->geom.length_mm / 2 >= 2 * l;
+    double turning = isolated ? kIsolatedBlendCentripetal : 0;
     switch (jn.blend) {
         case Blend::Curve:
             add_item(jn.curve, feed, jn.curve_end_cap_mm_s, jn.rough || jn.curve_end_rough, *next,
-                     rapid);
+                     rapid, turning);
             next->trim_start_mm = jn.blend_l_mm;
             next->rough_start = jn.curve_end_rough;
             return;
         case Blend::Parabola:
             add_item(make_parabola(p.geom.end, p.geom.a, next->geom.a, jn.blend_l_mm), feed, kInf,
-                     false, *next, rapid);
+                     false, *next, rapid, turning);
             break;
         case Blend::Quartic:
             add_item(make_blend(p.geom.end, p.geom.a, next->geom.a, jn.blend_l_mm), feed, kInf,
@@ -311,11 +386,11 @@ void Planner::close_piece(Piece& p, Piece* next) {
 }
 
 void Planner::add_item(const Element& e, double feed, double end_cap, bool rough,
-                       const Piece& owner, bool rapid) {
+                       const Piece& owner, bool rapid, double blend_centripetal) {
     Item it;
     it.geom = e;
     double cut = reserve_ + (rough ? cfg_.junction_share : 0);
-    it.lim = element_limits(e, bounds(e), cfg_.limits, feed, {1 - cut, 1 - cut});
+    it.lim = element_limits(e, bounds(e), cfg_.limits, feed, {1 - cut, 1 - cut, blend_centripetal});
     it.end_cap_mm_s = end_cap;
     it.rough = rough;
     it.line = owner.line;

@@ -20,6 +20,9 @@ namespace motion {
 struct LimitShares {
     double acc = 1;   // of acc_mm_s2
     double jerk = 1;  // of jerk_mm_s3
+    // Share of that acceleration a corner blend may spend turning, the rest being left for
+    // speed changes inside it; 0 = the default (0.95). Arcs and lines ignore it.
+    double blend_centripetal = 0;
 };
 
 struct ElementLimits {
@@ -30,6 +33,12 @@ struct ElementLimits {
 // feed_mm_s <= 0 means "no feed limit" (rapid).
 ElementLimits element_limits(const Element& e, const ElementBounds& b, const AxisLimits& lim,
                              double feed_mm_s, const LimitShares& share) noexcept;
+
+// Shortest cut l (mm) of a parabolic corner blend (make_parabola: second derivative
+// dt_turn / 2l, dt_turn = T2 - T1) whose speed cap under these shares is at least v_mm_s,
+// ignoring jerk limits.
+double parabola_cut_for_speed_mm(const AxisArray& dt_turn, double v_mm_s, const AxisLimits& lim,
+                                 const LimitShares& share) noexcept;
 
 // Largest factor (>= 1, <= max_rate) by which time may be sped up (feed override above 100 %)
 // on a stretch of this element where the path speed, |acceleration| and |jerk| peak at v, a, j,

@@ -112,14 +112,16 @@ class Planner {
     Junction classify(const Piece& p, const Piece& next) const;
     // A Bezier blend for a corner with an arc (or any corner without a jerk limit), or none
     // (blend_l_mm = 0) when no blend within the tolerance fits.
-    Junction bezier_corner(const Piece& p, const Piece& next, double sin_angle,
-                           double feed_mm_s) const;
+    // l_speed_mm: the longest cut worth making (see classify).
+    Junction bezier_corner(const Piece& p, const Piece& next, double sin_angle, double feed_mm_s,
+                           double l_speed_mm) const;
     // Highest speed at which a step between these second derivatives stays within the
     // junction share of one period's jerk (infinite without a jerk limit).
     double curvature_step_cap(const AxisArray& d2_before, const AxisArray& d2_after) const;
     void close_piece(Piece& p, Piece* next);
+    // blend_centripetal: LimitShares::blend_centripetal for a corner blend (0 = default).
     void add_item(const Element& e, double feed, double end_cap, bool rough, const Piece& owner,
-                  bool rapid);
+                  bool rapid, double blend_centripetal = 0);
     std::size_t plan_and_emit(bool all);  // returns how many records it emitted
     bool can_join(const Group& g, const Item& it) const;
     void build_groups();
