@@ -30,6 +30,8 @@ constexpr int kCells = 24;
 constexpr int kArcSamplesPerTurn = 128;
 // Window half-angles tried at an arc's extreme point.
 constexpr int kWindowSteps = 48;
+// Rounds of shrinking the reach with the component bound found so far (component_bound).
+constexpr int kReachRounds = 4;
 
 struct Move {
     Element e;
@@ -114,11 +116,19 @@ double hull_points(const Move& m, std::vector<Vec3>& pts) {
 
 // Largest d . (p - c) over the path from vertex v onwards (forward) or backwards, as far as the
 // tool can get while its velocity component along d is braked (the reach): the path is walked
-// until it first leaves the ball of radius reach_mm about c; the move that leaves it counts in
-// full. Past the program's ends the tool rests at the end point, which counts too.
+// until it first leaves the box |p_k - c_k| <= reach_k about c, which s cannot pass while the
+// component is braked (axis k moves at most V_k times the braking time, and the tool is within
+// P of c and of the path). A line counts up to where it leaves; an arc up to its first sample
+// outside (its hull from the start to there, grown by the sagitta, holds the part inside). Past
+// the program's ends the tool rests at the end point, which counts too.
 double extent(const std::vector<Move>& moves, const std::vector<Vec3>& vertex, std::size_t v,
-              const Vec3& d, bool forward, double reach_mm) {
+              const Vec3& d, bool forward, const Vec3& reach_mm) {
     const Vec3& c = vertex[v];
+    auto inside = [&](const Vec3& r) {
+        for (int k = 0; k < kDim; ++k)
+            if (std::fabs(r[k]) > reach_mm[k]) return false;
+        return true;
+    };
     double best = 0;  // c itself
     std::vector<Vec3> pts;
     std::size_t n = moves.size();
@@ -131,12 +141,30 @@ double extent(const std::vector<Move>& moves, const std::vector<Vec3>& vertex, s
             if (step >= v) break;
             i = v - 1 - step;
         }
-        double margin = hull_points(moves[i], pts);
+        const Move& m = moves[i];
+        if (!m.arc) {
+            Vec3 a = sub(xyz(forward ? m.e.origin : m.e.end), c);
+            Vec3 b = sub(xyz(forward ? m.e.end : m.e.origin), c);
+            double t_exit = 1;  // where the line leaves the box (a is inside)
+            for (int k = 0; k < kDim; ++k) {
+                double span = b[k] - a[k];
+                if (b[k] > reach_mm[k]) t_exit = std::min(t_exit, (reach_mm[k] - a[k]) / span);
+                if (b[k] < -reach_mm[k]) t_exit = std::min(t_exit, (-reach_mm[k] - a[k]) / span);
+            }
+            t_exit = std::max(t_exit, 0.0);
+            Vec3 e{a[0] + t_exit * (b[0] - a[0]), a[1] + t_exit * (b[1] - a[1]),
+                   a[2] + t_exit * (b[2] - a[2])};
+            best = std::max({best, dot(d, a), dot(d, e)});
+            if (t_exit < 1) break;
+            continue;
+        }
+        double margin = hull_points(m, pts);
+        if (!forward) std::reverse(pts.begin(), pts.end());
         bool left = false;
         for (const Vec3& p : pts) {
             Vec3 r = sub(p, c);
             best = std::max(best, dot(d, r) + margin);
-            left = left || norm(r) > reach_mm;
+            if ((left = !inside(r))) break;
         }
         if (left) break;
     }
@@ -147,21 +175,32 @@ struct CornerContext {
     const std::vector<Move>& moves;
     const std::vector<Vec3>& vertex;
     const AxisLimits& lim;
-    double reach_mm;
+    Vec3 reach_mm;      // per axis, see extent()
     double tol_max_mm;  // later path points count within the program's largest P
 };
 
 // Upper bound on |d . q'| at the instant s passes vertex v, for one direction d (either sign):
 // forward in time the tool cannot overshoot the path's extent along d by more than P after being
 // within P of the vertex, so (d . q')^2 <= 2 A_d (E_fwd + 2P), and backward in time likewise
-// (the second P is the program's largest, for the later path points).
+// (the second P is the program's largest, for the later path points). Braking w takes w / A_d,
+// so a bound on w shrinks the reach (axis k moves at most V_k w / A_d meanwhile), which can
+// lower the bound again: a few rounds, each sound given the last.
 double component_bound(const CornerContext& cx, std::size_t v, const Vec3& d, double tol_mm) {
     double a_d = box_support(d, cx.lim.acc_mm_s2);
     auto one_sign = [&](const Vec3& dir) {
         Vec3 back{-dir[0], -dir[1], -dir[2]};
-        double e = std::min(extent(cx.moves, cx.vertex, v, dir, true, cx.reach_mm),
-                            extent(cx.moves, cx.vertex, v, back, false, cx.reach_mm));
-        return std::sqrt(2 * a_d * (e + tol_mm + cx.tol_max_mm));
+        double w = box_support(dir, cx.lim.vel_mm_s);
+        Vec3 reach = cx.reach_mm;
+        for (int round = 0; round < kReachRounds; ++round) {
+            double e = std::min(extent(cx.moves, cx.vertex, v, dir, true, reach),
+                                extent(cx.moves, cx.vertex, v, back, false, reach));
+            double w_next = std::sqrt(2 * a_d * (e + tol_mm + cx.tol_max_mm));
+            if (w_next >= w) break;
+            w = w_next;
+            for (int k = 0; k < kDim; ++k)
+                reach[k] = std::min(reach[k], 2 * cx.tol_max_mm + cx.lim.vel_mm_s[k] * w / a_d);
+        }
+        return w;
     };
     return std::max(one_sign(d), one_sign({-d[0], -d[1], -d[2]}));
 }
@@ -192,7 +231,6 @@ CornerCaps corner_caps(const CornerContext& cx, std::size_t v, int& capped, int&
     double cos_turn = dot(u1, u2);
     if (cos_turn > 1 - 1e-12) return {};            // tangent
     if (in.tolerance_mm <= 0) return ++stops, stop;  // G61: a kink on the exact path is a stop
-    if (cos_turn > 0) return {};
     Vec3 e2 = unit_or_zero(sub(u2, {cos_turn * u1[0], cos_turn * u1[1], cos_turn * u1[2]}));
     if (norm(e2) == 0)
         e2 = unit_or_zero(cross(u1, std::fabs(u1[0]) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0}));
@@ -315,15 +353,16 @@ AccelBoundResult accel_lower_bound(const BenchProgram& prog, const AxisLimits& l
     std::size_t n = moves.size();
     if (n == 0) return res;
 
-    // How far the tool can get while one velocity component is braked: at most the largest tool
-    // speed times the longest braking time, plus 2P (max P in the program).
-    double vtool2 = 0, acc_min = kInf, tol_max = 0;
-    for (int k = 0; k < kDim; ++k) {
-        vtool2 += lim.vel_mm_s[k] * lim.vel_mm_s[k];
-        acc_min = std::min(acc_min, lim.acc_mm_s2[k]);
-    }
+    // How far each axis can get while one velocity component is braked: V_k times the longest
+    // braking time, plus 2P (max P in the program). The component w = d . q' is at most
+    // sum_k V_k |d_k| and is braked at A_d = sum_k A_k |d_k|, so braking takes at most
+    // w / A_d <= max_k V_k / A_k.
+    double brake_s = 0, tol_max = 0;
+    for (int k = 0; k < kDim; ++k) brake_s = std::max(brake_s, lim.vel_mm_s[k] / lim.acc_mm_s2[k]);
     for (const Move& m : moves) tol_max = std::max(tol_max, m.tolerance_mm);
-    CornerContext cx{moves, vertex, lim, 2 * tol_max + vtool2 / acc_min, tol_max};
+    Vec3 reach;
+    for (int k = 0; k < kDim; ++k) reach[k] = 2 * tol_max + lim.vel_mm_s[k] * brake_s;
+    CornerContext cx{moves, vertex, lim, reach, tol_max};
     std::vector<CornerCaps> cap(n + 1);
     for (std::size_t v = 0; v <= n; ++v)
         cap[v] = corner_caps(cx, v, res.capped_corners, res.stops);
