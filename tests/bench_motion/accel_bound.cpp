@@ -241,9 +241,24 @@ CornerCaps corner_caps(const CornerContext& cx, std::size_t v, int& capped, int&
         double b = component_bound(cx, v, d, in.tolerance_mm);
         sum2 += b * b;
     }
-    caps.speed = std::sqrt(sum2);
-    caps.along_in = component_bound(cx, v, u1, in.tolerance_mm);
-    caps.along_out = component_bound(cx, v, u2, in.tolerance_mm);
+    // The axes' own components bound those along u1 and u2 too (|u . q'| <= sum_k |u_k| |q'_k|),
+    // which is tighter where a line is nearly along an axis whose path stops there (the end of a
+    // sine row: u1 is 5 degrees off X, and the path goes on along u1 only by that skew).
+    Vec3 axis_caps, speed_axes{0, 0, 0};
+    for (int k = 0; k < kDim; ++k) {
+        Vec3 ek{0, 0, 0};
+        ek[k] = 1;
+        axis_caps[k] = component_bound(cx, v, ek, in.tolerance_mm);
+        speed_axes[k] = axis_caps[k] * axis_caps[k];
+    }
+    caps.speed =
+        std::min(std::sqrt(sum2), std::sqrt(speed_axes[0] + speed_axes[1] + speed_axes[2]));
+    auto via_axes = [&](const Vec3& u) {
+        return std::fabs(u[0]) * axis_caps[0] + std::fabs(u[1]) * axis_caps[1] +
+               std::fabs(u[2]) * axis_caps[2];
+    };
+    caps.along_in = std::min(component_bound(cx, v, u1, in.tolerance_mm), via_axes(u1));
+    caps.along_out = std::min(component_bound(cx, v, u2, in.tolerance_mm), via_axes(u2));
     ++capped;
     return caps;
 }
@@ -323,6 +338,37 @@ struct ChainState {
     bool pinned = true;                 // z = 0 exactly (program start)
 };
 
+// Carries the component caps of step 1 along chains of lines (a backward and a forward pass),
+// so that a run of short moves into a corner must slow down before its last move. During line
+// i (from vertex i to i + 1, direction u) the tool stays within P of it, so y = u . q moves at
+// most L + 2P forwards, with |y''| <= A_u = sum_k A_k |u_k|: to end the line with y' within the
+// cap B at vertex i + 1 it must start with y' <= sqrt(B^2 + 2 A_u (L + 2P)), and the same
+// forwards. At a vertex the components along the two lines' directions belong to one velocity,
+// so they differ by at most (u_i - u_{i+1}) . q' <= sum_k V_k |u_i,k - u_{i+1},k|. Arcs cut the
+// chain (their caps stay as step 1 gives them).
+void propagate_caps(const std::vector<Move>& moves, const AxisLimits& lim, double tol_mm,
+                    std::vector<CornerCaps>& cap) {
+    std::size_t n = moves.size();
+    auto line_dir = [&](std::size_t i) { return start_tangent(moves[i]); };
+    auto reach_speed = [&](std::size_t i, double from) {
+        double acc = box_support(line_dir(i), lim.acc_mm_s2);
+        return std::sqrt(from * from + 2 * acc * (moves[i].length_mm + 2 * tol_mm));
+    };
+    auto skew = [&](std::size_t v) {  // vertex v joins lines v - 1 and v
+        return box_support(sub(line_dir(v - 1), line_dir(v)), lim.vel_mm_s);
+    };
+    for (std::size_t v = n - 1; v >= 1; --v) {
+        if (moves[v].arc || moves[v - 1].arc) continue;
+        cap[v].along_out = std::min(cap[v].along_out, reach_speed(v, cap[v + 1].along_in));
+        cap[v].along_in = std::min(cap[v].along_in, cap[v].along_out + skew(v));
+    }
+    for (std::size_t v = 1; v < n; ++v) {
+        if (moves[v].arc || moves[v - 1].arc) continue;
+        cap[v].along_in = std::min(cap[v].along_in, reach_speed(v - 1, cap[v - 1].along_out));
+        cap[v].along_out = std::min(cap[v].along_out, cap[v].along_in + skew(v));
+    }
+}
+
 }  // namespace
 
 AccelBoundResult accel_lower_bound(const BenchProgram& prog, const AxisLimits& lim) {
@@ -366,6 +412,7 @@ AccelBoundResult accel_lower_bound(const BenchProgram& prog, const AxisLimits& l
     std::vector<CornerCaps> cap(n + 1);
     for (std::size_t v = 0; v <= n; ++v)
         cap[v] = corner_caps(cx, v, res.capped_corners, res.stops);
+    propagate_caps(moves, lim, tol_max, cap);
 
     // Offset grid: cell m covers z in [g(m), g(m+1)], g(m) = P (2m / kCells - 1).
     ChainState st;
