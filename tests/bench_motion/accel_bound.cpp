@@ -114,22 +114,34 @@ double hull_points(const Move& m, std::vector<Vec3>& pts) {
     return m.e.radius_mm * (1 - std::cos(half_step));
 }
 
+// What the tool can reach while a velocity component is braked: a box about the vertex (axis k
+// moves at most V_k times the braking time, plus 2P) and the braking time itself, which also
+// limits how far along the path s can get (see extent()).
+struct Reach {
+    Vec3 box_mm;
+    double time_s;
+    double tol_mm;      // the program's largest P
+    double vtool_mm_s;  // the tool's largest speed, |q'| <= sqrt(sum_k V_k^2)
+};
+
 // Largest d . (p - c) over the path from vertex v onwards (forward) or backwards, as far as the
-// tool can get while its velocity component along d is braked (the reach): the path is walked
-// until it first leaves the box |p_k - c_k| <= reach_k about c, which s cannot pass while the
-// component is braked (axis k moves at most V_k times the braking time, and the tool is within
-// P of c and of the path). A line counts up to where it leaves; an arc up to its first sample
-// outside (its hull from the start to there, grown by the sagitta, holds the part inside). Past
-// the program's ends the tool rests at the end point, which counts too.
+// tool can get while its velocity component along d is braked: s cannot pass the first point of
+// the path outside the box (the tool is within P of c and of the path), nor get further than the
+// braking time allows: between the instants s passes two points of the path the tool moves at
+// least their distance less 2P, at most at the feed (feed moves) or at its largest speed. A line
+// counts up to where it leaves; an arc up to its first sample out of reach (its hull from the
+// start to there, grown by the sagitta, holds the part within). Past the program's ends the tool
+// rests at the end point, which counts too.
 double extent(const std::vector<Move>& moves, const std::vector<Vec3>& vertex, std::size_t v,
-              const Vec3& d, bool forward, const Vec3& reach_mm) {
+              const Vec3& d, bool forward, const Reach& reach) {
     const Vec3& c = vertex[v];
     auto inside = [&](const Vec3& r) {
         for (int k = 0; k < kDim; ++k)
-            if (std::fabs(r[k]) > reach_mm[k]) return false;
+            if (std::fabs(r[k]) > reach.box_mm[k]) return false;
         return true;
     };
     double best = 0;  // c itself
+    double time_left_s = reach.time_s;
     std::vector<Vec3> pts;
     std::size_t n = moves.size();
     for (std::size_t step = 0;; ++step) {
@@ -142,29 +154,38 @@ double extent(const std::vector<Move>& moves, const std::vector<Vec3>& vertex, s
             i = v - 1 - step;
         }
         const Move& m = moves[i];
+        double speed = m.feed_mm_s > 0 ? std::min(m.feed_mm_s, reach.vtool_mm_s) : reach.vtool_mm_s;
+        // Time to get from one point of the path to another d_mm away, at least.
+        auto least_time = [&](double d_mm) {
+            return std::max(0.0, d_mm - 2 * reach.tol_mm) / speed;
+        };
         if (!m.arc) {
             Vec3 a = sub(xyz(forward ? m.e.origin : m.e.end), c);
             Vec3 b = sub(xyz(forward ? m.e.end : m.e.origin), c);
-            double t_exit = 1;  // where the line leaves the box (a is inside)
+            // Where the line leaves the box (a is inside) or the time runs out.
+            double t_exit = std::min(1.0, (speed * time_left_s + 2 * reach.tol_mm) / m.length_mm);
             for (int k = 0; k < kDim; ++k) {
                 double span = b[k] - a[k];
-                if (b[k] > reach_mm[k]) t_exit = std::min(t_exit, (reach_mm[k] - a[k]) / span);
-                if (b[k] < -reach_mm[k]) t_exit = std::min(t_exit, (-reach_mm[k] - a[k]) / span);
+                double lim = reach.box_mm[k];
+                if (b[k] > lim) t_exit = std::min(t_exit, (lim - a[k]) / span);
+                if (b[k] < -lim) t_exit = std::min(t_exit, (-lim - a[k]) / span);
             }
             t_exit = std::max(t_exit, 0.0);
             Vec3 e{a[0] + t_exit * (b[0] - a[0]), a[1] + t_exit * (b[1] - a[1]),
                    a[2] + t_exit * (b[2] - a[2])};
             best = std::max({best, dot(d, a), dot(d, e)});
             if (t_exit < 1) break;
+            time_left_s -= least_time(m.length_mm);
             continue;
         }
         double margin = hull_points(m, pts);
         if (!forward) std::reverse(pts.begin(), pts.end());
         bool left = false;
-        for (const Vec3& p : pts) {
-            Vec3 r = sub(p, c);
+        for (std::size_t j = 0; j < pts.size(); ++j) {
+            Vec3 r = sub(pts[j], c);
             best = std::max(best, dot(d, r) + margin);
-            if ((left = !inside(r))) break;
+            if (j > 0) time_left_s -= least_time(norm(sub(pts[j], pts[j - 1])));
+            if ((left = !inside(r) || time_left_s < 0)) break;
         }
         if (left) break;
     }
@@ -175,7 +196,7 @@ struct CornerContext {
     const std::vector<Move>& moves;
     const std::vector<Vec3>& vertex;
     const AxisLimits& lim;
-    Vec3 reach_mm;      // per axis, see extent()
+    Reach reach;        // with the longest braking time, see extent()
     double tol_max_mm;  // later path points count within the program's largest P
 };
 
@@ -190,15 +211,17 @@ double component_bound(const CornerContext& cx, std::size_t v, const Vec3& d, do
     auto one_sign = [&](const Vec3& dir) {
         Vec3 back{-dir[0], -dir[1], -dir[2]};
         double w = box_support(dir, cx.lim.vel_mm_s);
-        Vec3 reach = cx.reach_mm;
+        Reach reach = cx.reach;
         for (int round = 0; round < kReachRounds; ++round) {
             double e = std::min(extent(cx.moves, cx.vertex, v, dir, true, reach),
                                 extent(cx.moves, cx.vertex, v, back, false, reach));
             double w_next = std::sqrt(2 * a_d * (e + tol_mm + cx.tol_max_mm));
             if (w_next >= w) break;
             w = w_next;
+            reach.time_s = std::min(reach.time_s, w / a_d);
             for (int k = 0; k < kDim; ++k)
-                reach[k] = std::min(reach[k], 2 * cx.tol_max_mm + cx.lim.vel_mm_s[k] * w / a_d);
+                reach.box_mm[k] =
+                    std::min(reach.box_mm[k], 2 * cx.tol_max_mm + cx.lim.vel_mm_s[k] * w / a_d);
         }
         return w;
     };
@@ -406,8 +429,12 @@ AccelBoundResult accel_lower_bound(const BenchProgram& prog, const AxisLimits& l
     double brake_s = 0, tol_max = 0;
     for (int k = 0; k < kDim; ++k) brake_s = std::max(brake_s, lim.vel_mm_s[k] / lim.acc_mm_s2[k]);
     for (const Move& m : moves) tol_max = std::max(tol_max, m.tolerance_mm);
-    Vec3 reach;
-    for (int k = 0; k < kDim; ++k) reach[k] = 2 * tol_max + lim.vel_mm_s[k] * brake_s;
+    Reach reach{{}, brake_s, tol_max, 0};
+    for (int k = 0; k < kDim; ++k) {
+        reach.box_mm[k] = 2 * tol_max + lim.vel_mm_s[k] * brake_s;
+        reach.vtool_mm_s += lim.vel_mm_s[k] * lim.vel_mm_s[k];
+    }
+    reach.vtool_mm_s = std::sqrt(reach.vtool_mm_s);
     CornerContext cx{moves, vertex, lim, reach, tol_max};
     std::vector<CornerCaps> cap(n + 1);
     for (std::size_t v = 0; v <= n; ++v)
