@@ -104,8 +104,20 @@ void evaluate(const Element& e, double s, CurvePoint& out) noexcept {
     evaluate_to<3>(e, s, out);
 }
 
-void evaluate_to_d2(const Element& e, double s_mm, CurvePoint& out) noexcept {
-    evaluate_to<2>(e, s_mm, out);
+void evaluate_upto(const Element& e, double s_mm, int order, CurvePoint& out) noexcept {
+    switch (order) {
+        case 0:
+            evaluate_to<0>(e, s_mm, out);
+            return;
+        case 1:
+            evaluate_to<1>(e, s_mm, out);
+            return;
+        case 2:
+            evaluate_to<2>(e, s_mm, out);
+            return;
+        default:
+            evaluate_to<3>(e, s_mm, out);
+    }
 }
 
 AxisArray point_at(const Element& e, double s_mm) noexcept {
@@ -376,19 +388,26 @@ constexpr double kChordSlackShare = 0.02;
 // Halvings of a blend before bezier_within gives up (2^6 pieces).
 constexpr int kMaxSplitDepth = 6;
 
-// Whether e changes axis k anywhere.
-bool moves_axis(const Element& e, int k) {
+// Sets moving[k] for every axis e changes anywhere (and leaves the others as they were).
+void mark_moving_axes(const Element& e, std::array<bool, kAxes>& moving) {
     switch (e.kind) {
         case ElementKind::Line:
-            return e.a[k] != 0;
+            for (int k = 0; k < kAxes; ++k) moving[k] = moving[k] || e.a[k] != 0;
+            return;
         case ElementKind::Arc:
-            return e.a[k] != 0 || e.b[k] != 0 || e.c[k] != 0;
+            for (int k = 0; k < kAxes; ++k)
+                moving[k] = moving[k] || e.a[k] != 0 || e.b[k] != 0 || e.c[k] != 0;
+            return;
         case ElementKind::Blend:
-            return e.a[k] != 0 || e.b[k] != 0;
+            for (int k = 0; k < kAxes; ++k) moving[k] = moving[k] || e.a[k] != 0 || e.b[k] != 0;
+            return;
         case ElementKind::Bezier:
-            return e.a[k] != e.origin[k] || e.b[k] != e.origin[k] || e.end[k] != e.origin[k];
+            for (int k = 0; k < kAxes; ++k)
+                moving[k] = moving[k] || e.a[k] != e.origin[k] || e.b[k] != e.origin[k] ||
+                            e.end[k] != e.origin[k];
+            return;
     }
-    return true;
+    moving.fill(true);
 }
 
 // Chords of e over [s0, s1]; `known` is the point at `known_s` (s0 or s1), which saves an
@@ -430,6 +449,8 @@ using Hull = std::array<AxisArray, 4>;
 
 // What bezier_within works with: the path, the limit, the dimensions of the hull points, and
 // the squared distance from the path in the axes neither moves (the same for all points).
+// PathDims is path.dims when known at compile time (the loops unroll), else 0.
+template <int PathDims>
 struct Proof {
     const CornerPath& path;
     double limit_mm;
@@ -444,7 +465,7 @@ struct Proof {
 
     double chord_dist2(int c, const AxisArray& q) const {
         const AxisArray &a = path.from[c], &d = path.dir[c];
-        const int n = path.dims;
+        const int n = PathDims > 0 ? PathDims : path.dims;
         double t = 0;
         for (int k = 0; k < n; ++k) t += (q[k] - a[k]) * d[k];
         t = std::clamp(t * path.inv_len2[c], 0.0, 1.0);
@@ -497,13 +518,46 @@ void split_half(const Hull& q, Hull& left, Hull& right, int dims) {
     }
 }
 
+// Only the first `dims` values of each point are ever read.
+void copy_hull(Hull& to, const Hull& from, int dims) {
+    for (int i = 0; i < 4; ++i)
+        std::copy_n(from[i].begin(), dims, to[i].begin());
+}
+
+// Depth-first over the halvings of `piece` (in `dims` dimensions): `pending` holds the right
+// halves still to be proved.
+template <int PathDims>
+bool prove(const Proof<PathDims>& proof, Hull& piece, int dims) {
+    std::array<Hull, kMaxSplitDepth + 1> pending;
+    std::array<int, kMaxSplitDepth + 1> pending_depth;
+    int top = 0, depth = 0, hint = 0;
+    for (;;) {
+        // The whole blend spans both moves: start with its halves.
+        if (depth > 0 && proof.hull_near_path(piece, hint)) {
+            if (top == 0) return true;
+            --top;
+            copy_hull(piece, pending[top], dims);
+            depth = pending_depth[top];
+            continue;
+        }
+        if (depth == kMaxSplitDepth) return false;
+        Hull left;
+        split_half(piece, left, pending[top], dims);
+        if (proof.beyond_reach(left[3])) return false;
+        pending_depth[top++] = ++depth;
+        copy_hull(piece, left, dims);
+    }
+}
+
 }  // namespace
 
 CornerPath corner_path(const Element& before, double before_mm, const Element& after,
                        double after_mm, double limit_mm) noexcept {
     CornerPath path;
+    path.moving.fill(false);
+    mark_moving_axes(before, path.moving);
+    mark_moving_axes(after, path.moving);
     for (int k = 0; k < kAxes; ++k) {
-        path.moving[k] = moves_axis(before, k) || moves_axis(after, k);
         if (path.moving[k])
             path.axes[path.dims++] = k;
         else
@@ -516,42 +570,34 @@ CornerPath corner_path(const Element& before, double before_mm, const Element& a
 }
 
 bool bezier_within(const BezierPoints& bezier, const CornerPath& path, double limit_mm) noexcept {
-    const std::array<const AxisArray*, 4> ctrl{&bezier.p0, &bezier.p1, &bezier.p2, &bezier.p3};
     Hull piece;
-    for (int i = 0; i < 4; ++i)
-        for (int j = 0; j < path.dims; ++j) piece[i][j] = (*ctrl[i])[path.axes[j]];
+    for (int j = 0; j < path.dims; ++j) {
+        const int k = path.axes[j];
+        piece[0][j] = bezier.p0[k], piece[1][j] = bezier.p1[k];
+        piece[2][j] = bezier.p2[k], piece[3][j] = bezier.p3[k];
+    }
     int dims = path.dims;
     double still_axes2 = 0;
     for (int k = 0; k < kAxes; ++k) {
         if (path.moving[k]) continue;
         const double x0 = bezier.p0[k];
         if (bezier.p1[k] != x0 || bezier.p2[k] != x0 || bezier.p3[k] != x0) {
-            for (int i = 0; i < 4; ++i) piece[i][dims] = (*ctrl[i])[k] - path.fixed[k];
+            piece[0][dims] = bezier.p0[k] - path.fixed[k];
+            piece[1][dims] = bezier.p1[k] - path.fixed[k];
+            piece[2][dims] = bezier.p2[k] - path.fixed[k];
+            piece[3][dims] = bezier.p3[k] - path.fixed[k];
             ++dims;
         } else {
             still_axes2 += (x0 - path.fixed[k]) * (x0 - path.fixed[k]);
         }
     }
-    const Proof proof{path, limit_mm, still_axes2, dims};
-    // Depth-first over the halvings: `pending` holds the right halves still to be proved.
-    std::array<Hull, kMaxSplitDepth + 1> pending;
-    std::array<int, kMaxSplitDepth + 1> pending_depth{};
-    int top = 0, depth = 0, hint = 0;
-    for (;;) {
-        // The whole blend spans both moves: start with its halves.
-        if (depth > 0 && proof.hull_near_path(piece, hint)) {
-            if (top == 0) return true;
-            --top;
-            piece = pending[top];
-            depth = pending_depth[top];
-            continue;
-        }
-        if (depth == kMaxSplitDepth) return false;
-        Hull left;
-        split_half(piece, left, pending[top], dims);
-        if (proof.beyond_reach(left[3])) return false;
-        pending_depth[top++] = ++depth;
-        piece = left;
+    switch (path.dims) {
+        case 2:
+            return prove(Proof<2>{path, limit_mm, still_axes2, dims}, piece, dims);
+        case 3:
+            return prove(Proof<3>{path, limit_mm, still_axes2, dims}, piece, dims);
+        default:
+            return prove(Proof<0>{path, limit_mm, still_axes2, dims}, piece, dims);
     }
 }
 

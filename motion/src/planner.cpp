@@ -301,8 +301,9 @@ Planner::Junction Planner::bezier_corner(const Piece& p, const Piece& next, doub
         BezierPoints ctrl;
     };
     auto fits = [&](double l_try, Fit& out) {
-        evaluate_to_d2(p.geom, L1 - l_try, out.a);
-        evaluate_to_d2(next.geom, l_try, out.b);
+        const int order = jerk_mode_ ? 2 : 1;  // p'' only for the curvature steps
+        evaluate_upto(p.geom, L1 - l_try, order, out.a);
+        evaluate_upto(next.geom, l_try, order, out.b);
         std::optional<BezierPoints> ctrl =
             corner_bezier_points(out.a.p, out.a.d1, out.b.p, out.b.d1, l_try);
         if (!ctrl || !bezier_within(*ctrl, path, allowed_mm)) return false;
@@ -387,16 +388,16 @@ void Planner::close_piece(Piece& p, Piece* next) {
 
 void Planner::add_item(const Element& e, double feed, double end_cap, bool rough,
                        const Piece& owner, bool rapid, double blend_centripetal) {
-    Item it;
+    Item& it = items_.emplace_back();
     it.geom = e;
+    it.bounds = bounds(e);
     double cut = reserve_ + (rough ? cfg_.junction_share : 0);
-    it.lim = element_limits(e, bounds(e), cfg_.limits, feed, {1 - cut, 1 - cut, blend_centripetal});
+    it.lim = element_limits(e, it.bounds, cfg_.limits, feed, {1 - cut, 1 - cut, blend_centripetal});
     it.end_cap_mm_s = end_cap;
     it.rough = rough;
     it.line = owner.line;
     it.move_id = owner.move_id;
     it.rapid = rapid;
-    items_.push_back(it);
 }
 
 bool Planner::can_join(const Group& g, const Item& it) const {
@@ -584,7 +585,7 @@ void Planner::emit(const Item& it, const Profile1D& prof) {
     rec.geom = it.geom;
     rec.profile = prof;
     LimitShares rate_share{1 - reserve_, 1 - reserve_};
-    ElementBounds b = bounds(it.geom);
+    const ElementBounds& b = it.bounds;
     for (int i = 0; i < prof.count; ++i) {
         // Peaks of a cubic phase are at its ends (|v| and |a| are monotone within a phase).
         const ProfilePhase& ph = prof.phases[i];

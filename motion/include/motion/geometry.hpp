@@ -54,9 +54,10 @@ struct CurvePoint {
 
 // Realtime-safe: noexcept, no allocation, constant time.
 void evaluate(const Element& e, double s_mm, CurvePoint& out) noexcept;
-// The same values as evaluate() for what they set: p, d1 and d2 only (d3 is left as it was),
-// or the position only. For the planner, which needs no more at most of its points.
-void evaluate_to_d2(const Element& e, double s_mm, CurvePoint& out) noexcept;
+// The same values as evaluate() for what they set: p and the derivatives up to `order` (0-3;
+// the others are left as they were), or the position only. For the planner, which needs no
+// more at most of its points.
+void evaluate_upto(const Element& e, double s_mm, int order, CurvePoint& out) noexcept;
 AxisArray point_at(const Element& e, double s_mm) noexcept;
 
 // Per-axis bounds over the whole element: |p'_k| <= g1[k], |p''_k| <= g2[k], |p'''_k| <= g3[k].

@@ -83,6 +83,7 @@ class Planner {
     };
     struct Item {
         Element geom;
+        ElementBounds bounds;  // bounds(geom), kept for the rate caps when it is emitted
         ElementLimits lim;
         double end_cap_mm_s;  // junction speed limit at its end
         bool rough;           // next to a junction that is not smooth
