@@ -7,7 +7,9 @@
 #include <fmt/format.h>
 
 #include <array>
+#include <cmath>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -60,6 +62,11 @@ class Interp : public hal::Instance, public interpcomp::MachineLink {
     std::uint64_t output_bits() const noexcept override { return bits(digital_out_); }
     double spindle_rpm() const noexcept override { return spindle_speed_in_.get(); }
     bool probe_tripped() const noexcept override { return probe_tripped_.get(); }
+    // interp.probe-pos-L unconnected (NaN): the machine position stands in.
+    double probe_pos_mm(int axis) const noexcept override {
+        const double trip = probe_pos_[static_cast<std::size_t>(axis)]->get();
+        return std::isnan(trip) ? machine_pos_mm(axis) : trip;
+    }
     bool abort_requested() const noexcept override { return abort_.get(); }
     void on_progress() noexcept override {
         program_line_ = runner_.line();
@@ -92,6 +99,15 @@ class Interp : public hal::Instance, public interpcomp::MachineLink {
         for (int a = 0; a < interp::kMachineAxes; ++a)
             pins[a] = std::make_unique<hal::In<double>>(
                 this, pin(fmt::format("machine-pos-{}", "xyzabc"[a])));
+        return pins;
+    }
+
+    std::array<std::unique_ptr<hal::In<double>>, 3> make_probe_pos() {
+        std::array<std::unique_ptr<hal::In<double>>, 3> pins;
+        for (int a = 0; a < 3; ++a)
+            pins[a] =
+                std::make_unique<hal::In<double>>(this, pin(fmt::format("probe-pos-{}", "xyz"[a])),
+                                                  std::numeric_limits<double>::quiet_NaN());
         return pins;
     }
 
@@ -147,6 +163,8 @@ class Interp : public hal::Instance, public interpcomp::MachineLink {
     hal::Array<hal::In<bool>> digital_out_{this, pin("digital-out-{:02}"), num_dio_};
     hal::In<double> spindle_speed_in_{this, pin("spindle-speed-in")};
     hal::In<bool> probe_tripped_{this, pin("probe-tripped")};
+    // interp.probe-pos-x/y/z: where the G904's inputs came (net from motion.probe-pos-L).
+    std::array<std::unique_ptr<hal::In<double>>, 3> probe_pos_ = make_probe_pos();
     hal::Stream stream_;
     interpcomp::ProgramRunner runner_;
     bool reported_ = false;

@@ -164,7 +164,7 @@ void ProgramRunner::adopt_probe_result(const interp::SourceLoc& loc,
     unsigned axes = 0;
     for (const auto& w : cm.axes) {
         if (!w) continue;
-        pos[w->axis] = link_.machine_pos_mm(w->axis);
+        pos[w->axis] = link_.probe_pos_mm(w->axis);  // the touch, not the stop beyond it
         axes |= 1u << w->axis;
     }
     executor_->adopt_machine_position(pos, axes);

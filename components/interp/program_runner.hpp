@@ -39,6 +39,9 @@ class MachineLink {
     virtual std::uint64_t output_bits() const noexcept = 0;
     virtual double spindle_rpm() const noexcept = 0;
     virtual bool probe_tripped() const noexcept = 0;
+    // Where the last G904's input came on axis 0..2 (X Y Z), machine coordinates; the live
+    // position where the machine tells nothing else.
+    virtual double probe_pos_mm(int axis) const noexcept { return machine_pos_mm(axis); }
     // Polled by the runner's thread: true gives the rest of the program up.
     virtual bool abort_requested() const noexcept { return false; }
     // Called by the runner's thread whenever its status (line, waiting, done, failed) may have

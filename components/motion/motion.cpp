@@ -478,7 +478,11 @@ class Motion : public hal::Instance {
         const motion::ProbeJog& jog = sampler_->probe_jog();
         if (!jog.finished()) return false;
         probe_tripped_ = jog.tripped();
-        if (feeder_) feeder_->report_probe(jog.pos_mm(), jog.tripped());
+        const motion::AxisArray trip_mm = jog.trip_mm();
+        hal::Out<double>* const pos_pins[motion::kProbeAxes] = {&probe_pos_x_, &probe_pos_y_,
+                                                                &probe_pos_z_};
+        for (int k = 0; k < motion::kProbeAxes; ++k) *pos_pins[k] = trip_mm[k] + home_shift_mm_[k];
+        if (feeder_) feeder_->report_probe(jog.pos_mm(), trip_mm, jog.tripped());
         return true;
     }
 
@@ -985,6 +989,11 @@ class Motion : public hal::Instance {
     hal::In<bool> resume_{this, pin("motion.resume")};
     hal::Out<bool> program_paused_{this, pin("motion.program-paused")};
     hal::Out<bool> probe_tripped_{this, pin("motion.probe-tripped")};
+    // Where the last G904's inputs came (machine coordinates of X Y Z; where the axis stopped
+    // if its input never came): LinuxCNC's probed position, net to interp.probe-pos-L.
+    hal::Out<double> probe_pos_x_{this, pin("motion.probe-pos-x")};
+    hal::Out<double> probe_pos_y_{this, pin("motion.probe-pos-y")};
+    hal::Out<double> probe_pos_z_{this, pin("motion.probe-pos-z")};
     hal::Out<std::uint32_t> message_count_{this, pin("motion.message-count")};
     hal::Out<bool> limits_masked_pin_{this, pin("motion.limits-masked")};
     hal::Out<bool> spindle_clamp_{this, pin("spindle.0.clamp")};

@@ -55,8 +55,10 @@ void ProgramFeeder::await_probe(const interp::SourceLoc& loc,
     probe_where_ = fmt::format("{}:{}:{}", loc.file, loc.line, loc.col);
 }
 
-void ProgramFeeder::report_probe(const motion::AxisArray& pos_mm, bool tripped) noexcept {
+void ProgramFeeder::report_probe(const motion::AxisArray& pos_mm, const motion::AxisArray& trip_mm,
+                                 bool tripped) noexcept {
     probe_pos_mm_ = pos_mm;
+    probe_trip_mm_ = trip_mm;
     probe_tripped_ = tripped;
     probes_done_.fetch_add(1, std::memory_order_release);
 }
@@ -67,14 +69,16 @@ bool ProgramFeeder::probe_result_waiting() const noexcept {
 }
 
 // The path goes on from where the conditional move stopped. With the interpreter in-process
-// its model learns that point too, and a move that ended without its inputs is the alarm
-// NCX-3 asks for; with the interp component, that component does both (it waits at the
-// barrier it sends after a G904 and reads motion.probe-tripped).
+// its model takes the point where the inputs came (the trip point; the machine stands a
+// braking distance beyond it), so an incremental move after the G904 is measured from the
+// touch, and a move that ended without its inputs is the alarm NCX-3 asks for; with the interp
+// component, that component does both (it waits at the barrier it sends after a G904 and
+// reads motion.probe-pos-L and motion.probe-tripped).
 void ProgramFeeder::take_probe_result() {
     probe_pending_ = false;
     sink_->restart_from(probe_pos_mm_);
     if (!executor_) return;
-    const motion::AxisArray machine_mm = sink_->to_machine(probe_pos_mm_);
+    const motion::AxisArray machine_mm = sink_->to_machine(probe_trip_mm_);
     interp::AxisVec pos{};
     unsigned axes = 0;
     for (const auto& w : probe_cmd_.axes) {

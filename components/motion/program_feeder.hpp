@@ -111,9 +111,10 @@ class ProgramFeeder {
     // A conditional move (G904) was queued: nothing after it is planned until report_probe().
     void await_probe(const interp::SourceLoc& loc, const interp::canon::ConditionalMove& cm);
 
-    // Servo thread, realtime-safe: the conditional move ended at pos_mm; tripped = every
-    // watched input reached its level.
-    void report_probe(const motion::AxisArray& pos_mm, bool tripped) noexcept;
+    // Servo thread, realtime-safe: the conditional move ended at pos_mm, its inputs came at
+    // trip_mm (ProbeJog::trip_mm); tripped = every watched input reached its level.
+    void report_probe(const motion::AxisArray& pos_mm, const motion::AxisArray& trip_mm,
+                      bool tripped) noexcept;
 
   private:
     enum class Progress { More, Starved, End };
@@ -177,6 +178,7 @@ class ProgramFeeder {
     std::atomic<std::uint32_t> probes_sent_{0};
     std::atomic<std::uint32_t> probes_done_{0};
     motion::AxisArray probe_pos_mm_{};
+    motion::AxisArray probe_trip_mm_{};
     bool probe_tripped_ = false;
 
     mutable std::mutex mutex_;

@@ -28,6 +28,14 @@ bool ProbeJog::finished() const noexcept {
            });
 }
 
+AxisArray ProbeJog::trip_mm() const noexcept {
+    AxisArray out = pos_mm_;
+    for (int k = 0; k < kProbeAxes; ++k)
+        if (axes_[k].state == State::Tripped || (axes_[k].state == State::Braking && !stopping_))
+            out[k] = axes_[k].trip_mm;
+    return out;
+}
+
 bool ProbeJog::tripped() const noexcept {
     bool any = false;
     for (const Axis& ax : axes_) {
@@ -58,7 +66,10 @@ void ProbeJog::step_axis(int k, double dt, bool at_level, double scale) noexcept
         vel_mm_s_[k] = 0;
         return;
     }
-    if (ax.state == State::Running && (stopping_ || at_level)) ax.state = State::Braking;
+    if (ax.state == State::Running && (stopping_ || at_level)) {
+        ax.state = State::Braking;
+        ax.trip_mm = pos_mm_[k];  // not yet stepped: last period's command
+    }
     const double dir = ax.cfg.speed_mm_s > 0 ? 1.0 : -1.0;
     const double a = ax.acc_mm_s2;
     const double travel = ax.cfg.travel_mm;

@@ -55,7 +55,8 @@ std::vector<double> final_position(const std::string& out) {
 }
 
 // The S0 §3.5.3 tool-setting routine's moves: G904 down to the setter, then an incremental lift
-// measured from where Z stopped, and a read of that point.
+// measured from where the switch closed (the trip point; Z stops a braking distance below
+// it), and a read of the point reached.
 TEST(CncRunIo, ToolSetterG904StopsAtTheSwitchAndTheProgramGoesOnFromThere) {
     ScratchDir scratch;
     const fs::path ini = tool_setter_ini(scratch.path(), -12.5);
@@ -69,12 +70,47 @@ TEST(CncRunIo, ToolSetterG904StopsAtTheSwitchAndTheProgramGoesOnFromThere) {
     ASSERT_EQ(pos.size(), 3u) << r.out;
     // why: from Z-5 the jog ramps to 5 mm/s in 10 periods (0.025 mm at 500 mm/s^2), then moves
     // 5 um a period: Z = -5.025 - 0.005 k. At k = 1495 it is -12.5 exactly, where the comparator
-    // (out = in1 > in0) stays FALSE; at -12.505 it closes, motion sees it in the next period and
-    // brakes from 5 mm/s: 10 periods of 4.75, 4.25 ... 0.25 um = 0.025 mm, so Z stops at -12.530.
-    // The lift of 5 mm from there ends at -7.530; #CURMACHPOS.Z reads that point, so X = 20 + Z.
-    EXPECT_NEAR(pos[2], -7.530, 1e-4);
+    // (out = in1 > in0) stays FALSE; at -12.505 it closes, motion sees it in the next period,
+    // latches the trip point -12.505 (the command of the period before) and brakes from 5 mm/s:
+    // 10 periods of 4.75, 4.25 ... 0.25 um = 0.025 mm, so Z stops at -12.530. The interpreter
+    // takes the trip point: the lift of 5 mm ends at -7.505; #CURMACHPOS.Z reads that point,
+    // so X = 20 + Z.
+    EXPECT_NEAR(pos[2], -7.505, 1e-4);
     EXPECT_NEAR(pos[0], 20 + pos[2], 1e-4);
     EXPECT_NEAR(pos[1], 10, 1e-9);
+}
+
+// S0 §3.5.3's floating tool-setting routine (FEATURES TSET-1) as the sim mill runs it through
+// the interp component: look-ahead closed, a message while Z goes down, the message cleared,
+// look-ahead open, the lift at 100 % override measured from the touch.
+TEST(CncRunIo, ToolSettingRoutineShowsItsMessagesAndLiftsFromTheTouch) {
+    ScratchDir scratch;
+    const fs::path ini = tool_setter_ini(scratch.path(), -12.5);
+    const fs::path prog = scratch.path() / "tset.ngc";
+    std::ofstream(prog) << "G90 G21\nG0 X10 Y10\nG0 Z-5\nM802 P196609\n"
+                           "M801 MSG \"|D|waiting for tool-setting signal\"\n"
+                           "G904 FZ-300 PZ3 LZ1 Z50\nM801 MSG \"\"\nM802 P196608\n"
+                           "G903 G00 G91 Z5\nG90\n#1 = #CURMACHPOS.Z\nG0 X=20+#1\nM30\n";
+    const RunResult r =
+        run_cnc(fmt::format("'{}' '{}' --sim-clock", ini.string(), prog.string()), scratch.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+    // why: as in ToolSetterG904StopsAtTheSwitch...: the switch closes at Z -12.505 (the trip
+    // point), Z stops at -12.530, the lift ends 5 mm above the trip point.
+    const std::vector<double> pos = final_position(r.out);
+    ASSERT_EQ(pos.size(), 3u) << r.out;
+    EXPECT_NEAR(pos[2], -7.505, 1e-4);
+    EXPECT_NEAR(pos[0], 12.495, 1e-4);
+    // why: the first message is due before the G904 starts (about 0.3 s: the rapids), the
+    // second when Z has stopped (the G904 runs 7.5 mm at 5 mm/s: past 1.5 s), so the progress
+    // line of 1 s comes between them.
+    const auto waiting =
+        r.out.find(prog.string() + ":5: message: |D|waiting for tool-setting signal\n");
+    const auto one_s = r.out.find("progress:     1.0 s");
+    const auto cleared = r.out.find(prog.string() + ":7: message: (cleared)\n");
+    ASSERT_NE(waiting, std::string::npos) << r.out;
+    ASSERT_NE(cleared, std::string::npos) << r.out;
+    EXPECT_LT(waiting, one_s) << r.out;
+    EXPECT_LT(one_s, cleared) << r.out;
 }
 
 TEST(CncRunIo, G904WithoutItsInputIsAnErrorAtItsLine) {

@@ -62,6 +62,29 @@ TEST(ProbeJog, InputStopsTheAxisWithinTheBrakingDistance) {
     EXPECT_NEAR(jog.pos_mm()[2], seen_mm - 0.05, 1e-12);
 }
 
+TEST(ProbeJog, TripPointIsWhereTheInputCameNotWhereTheAxisStopped) {
+    ProbeJog jog;
+    jog.start(AxisArray{0, 0, -1}, z_only(-10, 50, 3, true), limits(100, 1000));
+    for (int i = 0; i < 300; ++i) jog.step(kDt, 0, 1.0);
+    // why: 10 periods of ramp (0.05 mm) and 290 at 10 um: -1 - 0.05 - 2.9 = -3.95.
+    EXPECT_NEAR(jog.pos_mm()[2], -3.95, 1e-12);
+    EXPECT_EQ(jog.trip_mm()[2], jog.pos_mm()[2]);  // not tripped yet: where it is
+    run(jog, 1000, std::uint64_t{1} << 3);
+    // why: the input seen in period 301 answers the command of period 300 (-3.95); the axis
+    // brakes 0.05 mm beyond it. X and Y take no part: where they stand.
+    EXPECT_NEAR(jog.trip_mm()[2], -3.95, 1e-12);
+    EXPECT_NEAR(jog.pos_mm()[2], -4.0, 1e-12);
+    EXPECT_EQ(jog.trip_mm()[0], 0);
+    EXPECT_EQ(jog.trip_mm()[1], 0);
+}
+
+TEST(ProbeJog, AnAxisThatDidNotTripReportsItsStop) {
+    ProbeJog jog;
+    jog.start(AxisArray{0, 0, -1}, z_only(-10, 2, 1, true), limits(100, 1000));
+    run(jog, 1000, 0);
+    EXPECT_EQ(jog.trip_mm()[2], -3);
+}
+
 TEST(ProbeJog, InputAlreadyAtItsLevelDoesNotMove) {
     ProbeJog jog;
     jog.start(AxisArray{0, 0, -1}, z_only(-10, 50, 0, false), limits(100, 1000));

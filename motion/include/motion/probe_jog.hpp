@@ -37,6 +37,11 @@ class ProbeJog {
     // Every taking-part axis stopped because its input reached the level.
     bool tripped() const noexcept;
     const AxisArray& pos_mm() const noexcept { return pos_mm_; }
+    // Where each axis was when its input came: the position commanded in the period before the
+    // one that saw the input at its level (the input a period reads answers the command of the
+    // period before). An axis that did not trip gives where it stopped; axes that do not take
+    // part, where they stand.
+    AxisArray trip_mm() const noexcept;
     const AxisArray& vel_mm_s() const noexcept { return vel_mm_s_; }
     void clear() noexcept { active_ = false; }
 
@@ -49,6 +54,7 @@ class ProbeJog {
         double acc_mm_s2 = 0;
         double vmax_mm_s = 0;
         bool landing = false;  // braking onto the farthest point
+        double trip_mm = 0;    // latched when the input came (State::Braking from Running)
     };
     void step_axis(int k, double dt, bool input_at_level, double scale) noexcept;
 
