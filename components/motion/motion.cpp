@@ -316,6 +316,8 @@ class Motion : public hal::Instance {
         tool_prepare_ = false;
         tool_change_ = false;
         pausing_ = false;
+        limits_masked_ = false;  // an abandoned program's M802 P131072 ends with it
+        limits_masked_pin_ = false;
         action_started_ = false;
     }
 

@@ -112,7 +112,13 @@ class Sink final : public PlanSink {
             rest(nullptr);
         }
     }
-    void handle(const interp::SourceLoc&, const interp::canon::ProgramEnd&) { rest(nullptr); }
+    // A program that masked the limit switches and did not restore them: they count again at
+    // its end, so the next program does not run with them masked.
+    void handle(const interp::SourceLoc& loc, const interp::canon::ProgramEnd&) {
+        if (limits_masked_) queue(loc, {motion::ActionKind::MaskLimits, false, 0, 0});
+        limits_masked_ = false;
+        rest(nullptr);
+    }
     // G906 without a port: motion comes to rest before the program goes on.
     void handle(const interp::SourceLoc&, const interp::canon::Sync&) { rest(nullptr); }
     // LinuxCNC waits for spindle.0.at-speed at the start of the next feed move after a spindle
@@ -179,7 +185,8 @@ class Sink final : public PlanSink {
         switch (m.code) {
             case kMaskLimits:
             case kRestoreLimits:
-                queue(loc, {motion::ActionKind::MaskLimits, m.code == kMaskLimits, 0, 0});
+                limits_masked_ = m.code == kMaskLimits;
+                queue(loc, {motion::ActionKind::MaskLimits, limits_masked_, 0, 0});
                 return;
             case kCloseBuffer:
             case kOpenBuffer:
@@ -365,6 +372,7 @@ class Sink final : public PlanSink {
     bool at_speed_due_ = false;     // the next feed move waits for spindle.0.at-speed
     motion::AxisArray shift_mm_{};  // machine coordinate minus planner frame, per axis (M902)
     bool buffer_closed_ = false;    // between M802 P196609 and P196608
+    bool limits_masked_ = false;    // between M802 P131072 and P131073
     std::int32_t last_move_line_ = -1;
     std::set<std::int64_t> unhandled_codes_;  // M802 codes already warned about
 
