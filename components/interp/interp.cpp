@@ -13,9 +13,9 @@
 #include <memory>
 #include <string>
 
+#include "../machine_program_ini.hpp"
 #include "hal/component.hpp"
 #include "interp/canon_wire.hpp"
-#include "interp/dialect.hpp"
 #include "program_runner.hpp"
 
 namespace {
@@ -130,9 +130,7 @@ class Interp : public hal::Instance, public interpcomp::MachineLink {
             throw hal::Error("program= is required: the G-code file to run");
         if (!std::ifstream(cfg.program_path))
             throw hal::Error(fmt::format("program={}: cannot open the file", cfg.program_path));
-        cfg.dialect = arg("dialect").value_or("");
-        if (!cfg.dialect.empty() && !interp::find_dialect(cfg.dialect))
-            throw hal::Error(fmt::format("dialect={}: unknown dialect", cfg.dialect));
+        cfg.options = machine_program::options_from_args(arg("ini"), arg("dialect"));
         cfg.standalone = arg_int("standalone", 0) != 0;
         return cfg;
     }
@@ -173,4 +171,4 @@ class Interp : public hal::Instance, public interpcomp::MachineLink {
 }  // namespace
 
 HAL_COMPONENT(interp, Interp, "G-code interpreter writing canonical commands into a HAL stream",
-              "program", "dialect", "stream", "depth", "standalone", "num_dio")
+              "program", "ini", "dialect", "stream", "depth", "standalone", "num_dio")

@@ -11,7 +11,6 @@
 #include "interp/dialect.hpp"
 #include "interp/executor.hpp"
 #include "interp/interpreter.hpp"
-#include "../machine_program.hpp"
 
 namespace interpcomp {
 
@@ -199,10 +198,10 @@ void ProgramRunner::finish(const std::string& error) {
 void ProgramRunner::open_program() {
     sink_ = std::make_unique<Sink>(*this);
     executor_ =
-        std::make_unique<interp::Executor>(*sink_, machine_program::backend_config(cfg_.dialect));
+        std::make_unique<interp::Executor>(*sink_, machine_program::backend_config(cfg_.options));
     machine_ = std::make_unique<LiveMachine>(*this, *executor_);
     interpreter_ = std::make_unique<interp::Interpreter>(
-        *executor_, *machine_, machine_program::interpreter_options(cfg_.dialect));
+        *executor_, *machine_, machine_program::interpreter_options(cfg_.options));
     interpreter_->open(cfg_.program_path);
 }
 

@@ -12,6 +12,7 @@
 #include <mutex>
 #include <string>
 
+#include "../machine_program.hpp"
 #include "hal/worker.hpp"
 #include "interp/canon.hpp"
 #include "interp/canon_wire.hpp"
@@ -51,7 +52,7 @@ class MachineLink {
 
 struct RunnerConfig {
     std::string program_path;
-    std::string dialect;      // empty: the interpreter's default (ncstudio)
+    machine_program::Options options;  // dialect and the machine's [RS274NGC] settings
     bool standalone = false;  // no machine: answer reads from the interpreter's own model
 };
 

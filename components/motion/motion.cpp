@@ -22,9 +22,9 @@
 #include <string>
 #include <vector>
 
+#include "../machine_program_ini.hpp"
 #include "hal/component.hpp"
 #include "interp/canon_wire.hpp"
-#include "interp/dialect.hpp"
 #include "kins_link.hpp"
 #include "motion/kinematics.hpp"
 #include "motion/planner.hpp"
@@ -114,9 +114,7 @@ class Motion : public hal::Instance {
                 throw hal::Error("give either program= or canon=, not both");
             canon_.emplace(hal::Stream::attach(this, *canon, interp::wire::kStreamLayout));
         }
-        dialect_ = arg("dialect").value_or("");
-        if (!dialect_.empty() && !interp::find_dialect(dialect_))
-            throw hal::Error(fmt::format("dialect={}: unknown dialect", dialect_));
+        program_options_ = machine_program::options_from_args(arg("ini"), arg("dialect"));
         const long period_ns = arg_int("servo_period_nsec", 1000000);
         if (period_ns <= 0) throw hal::Error("servo_period_nsec must be > 0");
         servo_period_s_ = static_cast<double>(period_ns) * 1e-9;
@@ -153,7 +151,7 @@ class Motion : public hal::Instance {
         motioncomp::FeederConfig cfg;
         cfg.program_path = program_path_;
         if (canon_) cfg.canon_source = [this](interp::wire::Record& r) { return pop_canon(r); };
-        cfg.dialect = dialect_;
+        cfg.program_options = program_options_;
         cfg.plan = plan;
         cfg.coordinates = coordinates_;
         for (char c : coordinates_) cfg.axis_present[motion::axis_index(c)] = true;
@@ -1012,7 +1010,7 @@ class Motion : public hal::Instance {
     bool limits_masked_ = false;         // M802 P131072 until P131073
     hal::Out<std::uint32_t> canon_sync_{this, pin("motion.canon-sync")};
     std::string program_path_;
-    std::string dialect_;
+    machine_program::Options program_options_;  // ini= and dialect=, for program=
     double servo_period_s_ = 1e-3;
     std::vector<double> joint_cmd_mm_;
     std::vector<double> joint_fb_mm_;    // scratch for forward()
@@ -1058,6 +1056,6 @@ class Motion : public hal::Instance {
 }  // namespace
 
 HAL_COMPONENT(motion, Motion, "Trajectory planner and servo-rate motion controller", "num_joints",
-              "coordinates", "kins", "program", "canon", "dialect", "servo_period_nsec", "queue", "sim_lockstep",
+              "coordinates", "kins", "program", "canon", "ini", "dialect", "servo_period_nsec", "queue", "sim_lockstep",
               "num_dio", "base_period_nsec", "traj_period_nsec", "num_aio", "num_spindles", "key",
               "base_thread_fp", "unlock_joints_mask")

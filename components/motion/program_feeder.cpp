@@ -10,7 +10,6 @@
 #include <utility>
 #include <variant>
 
-#include "../machine_program.hpp"
 #include "interp/canon.hpp"
 #include "interp/canon_wire.hpp"
 #include "interp/dialect.hpp"
@@ -227,10 +226,10 @@ void ProgramFeeder::open_program() {
         decoder_ = std::make_unique<interp::wire::Decoder>();
         return;
     }
-    executor_ =
-        std::make_unique<interp::Executor>(*sink_, machine_program::backend_config(cfg_.dialect));
+    executor_ = std::make_unique<interp::Executor>(
+        *sink_, machine_program::backend_config(cfg_.program_options));
     interpreter_ = std::make_unique<interp::Interpreter>(
-        *executor_, *executor_, machine_program::interpreter_options(cfg_.dialect));
+        *executor_, *executor_, machine_program::interpreter_options(cfg_.program_options));
     interpreter_->open(cfg_.program_path);
 }
 

@@ -21,6 +21,7 @@
 #include <string>
 #include <string_view>
 
+#include "../machine_program.hpp"
 #include "hal/worker.hpp"
 #include "interp/canon.hpp"
 #include "interp/canon_wire.hpp"
@@ -42,7 +43,7 @@ struct FeederConfig {
     // Pops the next record of the canonical stream (interp/canon_wire.hpp) into the argument;
     // false when none is waiting. Set: commands come from the stream, not from program_path.
     std::function<bool(interp::wire::Record&)> canon_source;
-    std::string dialect;  // empty: the interpreter's default (ncstudio)
+    machine_program::Options program_options;  // dialect and the machine's [RS274NGC] keys
     motion::PlannerConfig plan;
     std::array<bool, motion::kAxes> axis_present{};  // axes named by coordinates=
     std::string coordinates;                         // for error messages

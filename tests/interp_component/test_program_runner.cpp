@@ -112,7 +112,7 @@ constexpr const char* kRead = "G90 G21\nG1 X10 F600\n#1 = #CURMACHPOS.X\nG1 Y=#1
 TEST(ProgramRunner, ReadWaitsAtABarrierThenUsesTheLivePosition) {
     Program prog(kRead);
     FakeMachine machine;
-    ProgramRunner runner(RunnerConfig{prog.path(), "", false}, machine);
+    ProgramRunner runner(RunnerConfig{prog.path(), {}, false}, machine);
     EXPECT_FALSE(runner.start_and_wait_ready());
     // start returned because the runner waits for the machine: line 2's move and a barrier
     // were sent, nothing after them.
@@ -140,7 +140,7 @@ TEST(ProgramRunner, ReadWaitsAtABarrierThenUsesTheLivePosition) {
 TEST(ProgramRunner, StandaloneReadsTheModelWithoutWaiting) {
     Program prog(kRead);
     FakeMachine machine;
-    ProgramRunner runner(RunnerConfig{prog.path(), "", true}, machine);
+    ProgramRunner runner(RunnerConfig{prog.path(), {}, true}, machine);
     EXPECT_FALSE(runner.start_and_wait_ready());
     ASSERT_TRUE(eventually([&] { return runner.done(); }));
     runner.stop();
@@ -154,7 +154,7 @@ TEST(ProgramRunner, StandaloneReadsTheModelWithoutWaiting) {
 TEST(ProgramRunner, AbortWhileWaitingGivesTheProgramUpWithItsLocation) {
     Program prog(kRead);
     FakeMachine machine;
-    ProgramRunner runner(RunnerConfig{prog.path(), "", false}, machine);
+    ProgramRunner runner(RunnerConfig{prog.path(), {}, false}, machine);
     EXPECT_FALSE(runner.start_and_wait_ready());
     ASSERT_TRUE(eventually([&] { return runner.waiting(); }));
     machine.abort_.store(true);
@@ -170,7 +170,7 @@ TEST(ProgramRunner, AbortWhileWaitingGivesTheProgramUpWithItsLocation) {
 TEST(ProgramRunner, ASyntaxErrorFailsBeforeStartReturns) {
     Program prog("G90 G21\nG1 X10 F600\nG1 X20 Q\nM30\n");
     FakeMachine machine;
-    ProgramRunner runner(RunnerConfig{prog.path(), "", false}, machine);
+    ProgramRunner runner(RunnerConfig{prog.path(), {}, false}, machine);
     EXPECT_TRUE(runner.start_and_wait_ready());
     EXPECT_EQ(runner.error(), prog.path() + ":3:8: expected a number or '=' after Q");
     const auto lines = machine.lines();
@@ -187,7 +187,7 @@ TEST(ProgramRunner, ASyntaxErrorFailsBeforeStartReturns) {
 TEST(ProgramRunner, PortAndSpindleReadsComeFromTheMachine) {
     Program prog("G90 G21\nG1 X1 F600\n#1 = #IMPORTMAP\nG1 X=#1\nM30\n");
     FakeMachine machine;
-    ProgramRunner runner(RunnerConfig{prog.path(), "", false}, machine);
+    ProgramRunner runner(RunnerConfig{prog.path(), {}, false}, machine);
     EXPECT_FALSE(runner.start_and_wait_ready());
     ASSERT_TRUE(eventually([&] { return runner.waiting(); }));
     machine.reach_barriers();
@@ -206,7 +206,7 @@ TEST(ProgramRunner, ConditionalMoveContinuesFromWhereTheMachineStopped) {
     Program prog("G90 G21\nG904 FZ-600 PZ1 LZ1 Z20\nG91 G0 Z5\nM30\n");
     FakeMachine machine;
     machine.z_mm_.store(-3.25);
-    ProgramRunner runner(RunnerConfig{prog.path(), "", false}, machine);
+    ProgramRunner runner(RunnerConfig{prog.path(), {}, false}, machine);
     EXPECT_FALSE(runner.start_and_wait_ready());
     ASSERT_TRUE(eventually([&] { return runner.waiting(); }));
     EXPECT_EQ(machine.lines().back(), "2 sync");
@@ -226,7 +226,7 @@ TEST(ProgramRunner, ConditionalMoveWithoutItsInputFailsAtItsLine) {
     FakeMachine machine;
     machine.z_mm_.store(-20);
     machine.tripped_.store(false);
-    ProgramRunner runner(RunnerConfig{prog.path(), "", false}, machine);
+    ProgramRunner runner(RunnerConfig{prog.path(), {}, false}, machine);
     EXPECT_FALSE(runner.start_and_wait_ready());
     ASSERT_TRUE(eventually([&] { return runner.waiting(); }));
     machine.reach_barriers();

@@ -38,6 +38,7 @@
 #include <variant>
 #include <vector>
 
+#include "../../components/machine_program_ini.hpp"
 #include "backends.hpp"
 #include "hal/ini.hpp"
 #include "hal/script.hpp"
@@ -157,7 +158,7 @@ struct Config {
     double period_s = 0;
     std::string axis_letters;  // lower case, once each, in [TRAJ]COORDINATES order
     int program_lines = 0;
-    std::string dialect;  // [RS274NGC]DIALECT
+    std::string dialect;  // [RS274NGC]DIALECT, for the preview's line classes
 };
 
 int count_lines(const std::string& path) {
@@ -188,7 +189,10 @@ Config load_config(const RunOptions& o) {
             c.axis_letters += l;
     }
     c.program_lines = count_lines(o.program);
-    c.dialect = ini.get("RS274NGC", "DIALECT").value_or("ncstudio");
+    // The components read [RS274NGC] again (ini=$(INI_FILE_NAME)); a bad value is reported
+    // here first, as the INI's file:line, before anything is loaded.
+    c.dialect = machine_program::read_ini(ini).dialect;
+    if (c.dialect.empty()) c.dialect = "ncstudio";
     return c;
 }
 
@@ -946,8 +950,10 @@ int run_program(const RunOptions& o) {
         fmt::print(stderr, "{}\n", e.what());
         return 2;
     }
-    // The config's motion loadrt line reads these (see halfiles/motion_xyz.hal).
+    // The config's motion and interp loadrt lines read these (see halfiles/motion_xyz.hal,
+    // halfiles/interp.hal); INI_FILE_NAME is LinuxCNC's name for the machine's INI.
     ::setenv("CNC_PROGRAM", o.program.c_str(), 1);
+    ::setenv("INI_FILE_NAME", fs::absolute(o.ini).c_str(), 1);
     ::setenv("CNC_SIM_LOCKSTEP", o.sim_clock ? "1" : "0", 1);
     StopRequest stop;  // before the runtime: its threads inherit the signal mask
     try {
