@@ -61,14 +61,17 @@ class Decoder {
     enum class Item { None, Command, End };
     // Takes the next record. Command: command() holds it (its loc.file stays valid while the
     // decoder lives); End: the stream is over, error() says why if it failed; None: more
-    // records are needed. Throws wire::Error on a malformed sequence.
+    // records are needed. Throws wire::Error on a malformed sequence, naming the record by its
+    // number in the stream (1 = the first fed to this decoder).
     Item feed(const Record& r);
     const Canon& command() const { return command_; }
     bool failed() const { return failed_; }
     const std::string& error() const { return text_; }
 
   private:
+    Item take(const Record& r);
     Item complete();
+    std::uint64_t records_ = 0;  // fed so far, for locating a malformed one
     Record first_{};
     std::uint32_t continuations_left_ = 0;
     std::string text_;               // bytes of the continuation records of the current item

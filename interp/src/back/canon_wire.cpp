@@ -280,8 +280,8 @@ struct Reader : Archive {
         std::uint64_t size = 0;
         get(size);
         if (size > text_.size() - text_at_)
-            throw Error(fmt::format("canonical command '{}': text of {} bytes, only {} sent", what_,
-                                    size, text_.size() - text_at_));
+            throw Error(
+                fmt::format("a text of {} bytes, only {} sent", size, text_.size() - text_at_));
         s.assign(text_.substr(text_at_, size));
         text_at_ += size;
     }
@@ -337,7 +337,12 @@ bool decode_alternative(const Record& r, std::string_view text, CanonCommand& ou
     if constexpr (Listed<T>) {
         T c{};
         Reader reader(r, text, "");
-        fields(reader, c);
+        try {
+            fields(reader, c);
+        } catch (const Error& e) {
+            // Named only on this path: naming every decoded command would cost a format each.
+            throw Error(fmt::format("command '{}' has {}", name_of(CanonCommand{T{}}), e.what()));
+        }
         out = std::move(c);
         return true;
     } else {
@@ -406,24 +411,30 @@ void Encoder::end(std::string_view error, std::vector<Record>& out) {
 }
 
 Decoder::Item Decoder::feed(const Record& r) {
+    ++records_;
+    try {
+        return take(r);
+    } catch (const Error& e) {
+        throw Error(fmt::format("canonical stream, record {}: {}", records_, e.what()));
+    }
+}
+
+Decoder::Item Decoder::take(const Record& r) {
     if (continuations_left_ > 0) {
         if (type_of(r) != Type::Continuation)
-            throw Error(
-                fmt::format("canonical stream: expected {} more text record(s), got a "
-                            "record of type {}",
-                            continuations_left_, static_cast<int>(type_of(r))));
+            throw Error(fmt::format("expected {} more text record(s), got a record of type {}",
+                                    continuations_left_, static_cast<int>(type_of(r))));
         const char* bytes = reinterpret_cast<const char*>(&r[1]);
         text_.append(bytes, kTextBytesPerRecord);
         if (--continuations_left_ > 0) return Item::None;
         return complete();
     }
     const Type t = type_of(r);
+    if (t == Type::Continuation) throw Error("a text record with no command or file before it");
     if (t != Type::Command && t != Type::File && t != Type::End)
-        throw Error(
-            fmt::format("canonical stream: unexpected record of type {}", static_cast<int>(t)));
+        throw Error(fmt::format("unknown record type {}", static_cast<int>(t)));
     if (t == Type::Command && r[2] >= files_.size())
-        throw Error(
-            fmt::format("canonical stream: command names file id {}, never announced", r[2]));
+        throw Error(fmt::format("command names file id {}, never announced", r[2]));
     first_ = r;
     text_.clear();
     continuations_left_ = continuations_of(r);
@@ -437,8 +448,8 @@ Decoder::Item Decoder::complete() {
             // Texts are padded to whole records; the name ends at the first NUL.
             const std::string name = text_.substr(0, text_.find('\0'));
             if (first_[1] != files_.size())
-                throw Error(
-                    fmt::format("canonical stream: file id {} announced out of order", first_[1]));
+                throw Error(fmt::format("file id {} announced out of order (expected {})",
+                                        first_[1], files_.size()));
             files_.push_back(name);
             return Item::None;
         }
@@ -456,7 +467,7 @@ Decoder::Item Decoder::complete() {
     if (index >= std::variant_size_v<CanonCommand> ||
         !decode_command(index, first_, text_, command_.cmd,
                         std::make_index_sequence<std::variant_size_v<CanonCommand>>{}))
-        throw Error(fmt::format("canonical stream: unknown command index {}", index));
+        throw Error(fmt::format("unknown command index {}", index));
     return Item::Command;
 }
 

@@ -113,8 +113,17 @@ std::string axes_line(const AxisVec& v) {
     return s;
 }
 
-[[noreturn]] void sys_fail(const std::string& what, const std::string& path) {
-    throw std::runtime_error(fmt::format("{}: {}: {}", path, what, std::strerror(errno)));
+// `err` is the failed call's errno, taken before any clean-up call could change it.
+[[noreturn]] void sys_fail(const std::string& what, const std::string& path, int err) {
+    throw std::runtime_error(fmt::format("{}: {}: {}", path, what, std::strerror(err)));
+}
+
+// A failed save removes its temporary file, so the old settings file is all that is left.
+[[noreturn]] void abandon_tmp(int fd, const std::string& tmp, const char* what) {
+    const int err = errno;
+    if (fd >= 0) ::close(fd);
+    ::unlink(tmp.c_str());
+    sys_fail(what, tmp, err);
 }
 
 }  // namespace
@@ -162,27 +171,22 @@ void save_settings_atomic(const std::string& path, const Settings& s) {
     const std::string text = format_settings(s);
     const std::string tmp = path + ".tmp";
     int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) sys_fail("cannot create temporary settings file", tmp);
+    if (fd < 0) sys_fail("cannot create temporary settings file", tmp, errno);
     std::size_t done = 0;
     while (done < text.size()) {
         ssize_t n = ::write(fd, text.data() + done, text.size() - done);
         if (n < 0) {
             if (errno == EINTR) continue;
-            ::close(fd);
-            ::unlink(tmp.c_str());
-            sys_fail("cannot write settings", tmp);
+            abandon_tmp(fd, tmp, "cannot write settings");
         }
         done += static_cast<std::size_t>(n);
     }
-    if (::fsync(fd) != 0) {
-        ::close(fd);
-        ::unlink(tmp.c_str());
-        sys_fail("cannot fsync settings", tmp);
-    }
-    ::close(fd);
+    if (::fsync(fd) != 0) abandon_tmp(fd, tmp, "cannot fsync settings");
+    if (::close(fd) != 0) abandon_tmp(-1, tmp, "cannot write settings");
     if (::rename(tmp.c_str(), path.c_str()) != 0) {
+        const int err = errno;
         ::unlink(tmp.c_str());
-        sys_fail("cannot replace settings file", path);
+        sys_fail("cannot replace settings file", path, err);
     }
     // The rename itself must reach the disk, or a crash could bring back the old name.
     const std::filesystem::path parent = std::filesystem::path(path).parent_path();
