@@ -270,7 +270,7 @@ cycles::CycleWords BlockRun::cycle_words() const {
         if (has_axis(a)) w.axis_mm[a] = axis_value(a);
     if (b_.has('R')) w.r_mm = mm('R');
     if (b_.has('Q')) w.q_mm = mm('Q');
-    if (b_.has('P')) w.p_ms = b_.get('P');
+    if (b_.has('P')) w.p_ms = std::round(b_.get('P'));  // LEX-51
     // C-14: NcStudio documents K and uses L in its examples; both are the repeat count.
     if (b_.has('K'))
         w.k = b_.get('K');
@@ -308,9 +308,11 @@ cycles::CycleConfig BlockRun::cycle_config() const {
 
 void BlockRun::run_cycle() {
     if (!st.feed.feed_set || cfg_.use_default_speed) require_feed("a canned cycle");
-    // LEX-51: the dwell P is whole milliseconds, as for G04.
-    if (b_.has('P') && b_.get('P') != std::floor(b_.get('P')))
-        emit(canon::Warning{"canned-cycle P is in milliseconds; the fraction is kept"});
+    // LEX-51: the dwell P is whole milliseconds, as for G04 (cycle_words rounds it).
+    if (const double p = b_.has('P') ? b_.get('P') : 0; p != std::round(p))
+        emit(
+            canon::Warning{fmt::format("canned-cycle P{} is not whole milliseconds; rounded to P{}",
+                                       fmt_num(p), fmt_num(std::round(p)))});
     std::optional<cycles::CycleCode> code;
     if (cycle_code_ && *cycle_code_ != gcode(80))
         code = cycles::cycle_code_from_g(*cycle_code_ / 10);

@@ -180,11 +180,13 @@ void BlockRun::step_dwell() {
     if (!g(gcode(4))) return;
     double seconds = 0;
     if (b_.has('P')) {
-        const double ms = b_.get('P');
-        seconds = ms / 1000.0;  // DW-1: P in milliseconds
-        // LEX-51: whole milliseconds; `P1000.` and `P=#1` are fine, a real fraction is suspect.
-        if (ms != std::floor(ms))
-            emit(canon::Warning{"G04 P is in milliseconds; the fraction is kept"});
+        // DW-1, LEX-51: P is whole milliseconds ("不使用小数点"); `P1000.` and `P=#1` are fine,
+        // a real fraction is rounded, as the manual's millisecond timer would.
+        const double ms = std::round(b_.get('P'));
+        if (ms != b_.get('P'))
+            emit(canon::Warning{fmt::format("G04 P{} is not whole milliseconds; rounded to P{}",
+                                            fmt_num(b_.get('P')), fmt_num(ms))});
+        seconds = ms / 1000.0;
     } else if (b_.has('X') && !any_axis_word()) {
         seconds = b_.get('X');
     } else {

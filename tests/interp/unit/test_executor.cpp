@@ -138,18 +138,24 @@ TEST_F(ExecTest, G00_4_DefaultSpeedErrors) {
     EXPECT_EQ(run({"G905 G01 X1 F60"}), (V{"feed-rate 1mm/s", "feed X1 Y0 Z0 programmed-feed"}));
 }
 
-// LEX-51: dwell P is whole milliseconds; a real fraction is kept with a warning (G04 and cycles),
-// a trailing decimal point alone is not a fraction.
-TEST_F(ExecTest, LEX_51_DwellFractionsWarn) {
-    const std::string g04 = "warning \"G04 P is in milliseconds; the fraction is kept\"";
-    EXPECT_EQ(run({"G04 P1.5"}), (V{g04, "dwell 0.0015s"}));
+// LEX-51: dwell P is whole milliseconds (S0 §3.6.3 "不使用小数点"); a real fraction is rounded
+// to the nearest millisecond with a warning (G04 and cycles), a trailing decimal point alone is
+// not a fraction. By hand: round(1.5) = 2 ms, round(2.5) = 3 ms, round(0.4) = 0 ms.
+TEST_F(ExecTest, LEX_51_DwellFractionsAreRoundedWithAWarning) {
+    EXPECT_EQ(run({"G04 P1.5"}),
+              (V{"warning \"G04 P1.5 is not whole milliseconds; rounded to P2\"", "dwell 0.002s"}));
+    EXPECT_EQ(run({"G04 P0.4"}),
+              (V{"warning \"G04 P0.4 is not whole milliseconds; rounded to P0\"", "dwell 0s"}));
     EXPECT_EQ(run({"G04 P1000."}), (V{"dwell 1s"}));
     run({"G00 Z10"});
-    EXPECT_EQ(
-        run({"G82 X1 Y1 Z-1 R1 P2.5 F60"}),
-        (V{"feed-rate 1mm/s", "warning \"canned-cycle P is in milliseconds; the fraction is kept\"",
-           "traverse X1 Y1 Z10", "traverse X1 Y1 Z1", "feed X1 Y1 Z-1", "dwell 0.0025s",
-           "traverse X1 Y1 Z10"}));
+    EXPECT_EQ(run({"G82 X1 Y1 Z-1 R1 P2.5 F60"}),
+              (V{"feed-rate 1mm/s",
+                 "warning \"canned-cycle P2.5 is not whole milliseconds; rounded to P3\"",
+                 "traverse X1 Y1 Z10", "traverse X1 Y1 Z1", "feed X1 Y1 Z-1", "dwell 0.003s",
+                 "traverse X1 Y1 Z10"}));
+    // The rounded P is the cycle's modal dwell: the next hole dwells 3 ms too, unwarned.
+    EXPECT_EQ(run({"X2"}), (V{"traverse X2 Y1 Z10", "traverse X2 Y1 Z1", "feed X2 Y1 Z-1",
+                              "dwell 0.003s", "traverse X2 Y1 Z10"}));
 }
 
 TEST_F(ExecTest, FEED_8_FeedIsClampedWithOneWarningPerProgram) {
