@@ -27,7 +27,8 @@ struct Settings {
 };
 
 // A missing file gives default settings. A malformed one throws interp::Error naming
-// "file:line:col: cause" and nothing is changed on disk.
+// "file:line:col: cause", one that cannot be read (or is a directory) "file:0:0: settings:
+// cannot read file: cause"; nothing is changed on disk.
 Settings load_settings(const std::string& path);
 Settings parse_settings(const std::string& text, const std::string& name);
 std::string format_settings(const Settings& s);

@@ -144,13 +144,22 @@ Settings parse_settings(const std::string& text, const std::string& name) {
 }
 
 Settings load_settings(const std::string& path) {
+    // A directory opens like a file and reads as empty: it would load as the defaults, and the
+    // next save would fail far from the cause.
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+        throw Error(SourceLoc{path, 0, 0},
+                    fmt::format("settings: cannot read file: {}", std::strerror(EISDIR)));
     std::ifstream f(path, std::ios::binary);
     if (!f) {
+        const int err = errno;
         if (!std::filesystem::exists(path)) return Settings{};
-        throw Error(SourceLoc{path, 0, 0}, "settings: cannot read file");
+        throw Error(SourceLoc{path, 0, 0},
+                    fmt::format("settings: cannot read file: {}", std::strerror(err)));
     }
     std::ostringstream ss;
     ss << f.rdbuf();
+    if (f.bad()) throw Error(SourceLoc{path, 0, 0}, "settings: cannot read file: read error");
     return parse_settings(ss.str(), path);
 }
 

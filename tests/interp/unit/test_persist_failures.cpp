@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "interp/block.hpp"
 #include "interp/persist.hpp"
 
 namespace interp {
@@ -102,6 +103,17 @@ TEST_F(SaveFailure, ParentThatIsAFileIsNamed) {
                   under_file + ".tmp: cannot create temporary settings file: Not a directory");
     }
     EXPECT_EQ(read(path_), old_text_);
+}
+
+// A settings path that names a directory is not an empty settings file.
+TEST_F(SaveFailure, LoadingADirectoryIsAnError) {
+    try {
+        load_settings(dir_.string());
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  dir_.string() + ":0:0: settings: cannot read file: Is a directory");
+    }
 }
 
 // After a failure the next save (with the obstacle gone) replaces the file as usual.
