@@ -9,8 +9,8 @@
 // Joints are the machine's motors: every period the sampled axis position goes through the
 // machine's kinematics (kins_link.hpp: built-in trivial, or the kins_* module named by kins=)
 // to joint.N.motor-pos-cmd, and the joint feedback back through forward() to axis.L.pos-fb.
-// Following errors, limit switches and joint velocity/acceleration are per joint; soft limits
-// are per axis (checked by the planner).
+// Following errors, limit switches, joint velocity/acceleration and the joint soft limits are
+// per joint; the axis soft limits are checked by the planner.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -47,14 +47,17 @@ enum class FaultCause : std::uint8_t {
     NegLimit,
     WaitTimeout,
     KinsLost,
-    ToolOffsetJump
+    ToolOffsetJump,
+    JointSoftLimit
 };
 struct FaultReport {
     FaultCause cause = FaultCause::None;
     int joint = 0;
     std::int32_t line = 0;
     motion::Action action;
-    double amount = 0;  // ToolOffsetJump: how far the joint would have jumped
+    double amount = 0;  // ToolOffsetJump: how far the joint would have jumped; JointSoftLimit:
+                        // the joint's command
+    double min_mm = 0, max_mm = 0;  // JointSoftLimit: the joint's limits
 };
 
 // The e-stop handshake of LinuxCNC's iocontrol: iocontrol.0.emc-enable-in FALSE trips it
@@ -230,8 +233,10 @@ class Motion : public hal::Instance {
         for (const AxisPins& a : axes_) *a.pos_cmd = s.pos_mm[a.axis] + home_shift_mm_[a.axis];
         check_kinematics();  // after the actions: a tool offset set now applies now
         kins_.kins().inverse(s.pos_mm, joint_cmd_mm_);
+        check_joint_limits(enabled, s.line);  // before check_joint_motion moves joint_prev_mm_
         check_joint_motion(p.s, s.line);
-        if (write_joints(enabled) && !drive_fault_) {
+        // A joint limit tripped now drops the amps now, as a limit switch does.
+        if (write_joints(enabled && !limit_fault_) && !drive_fault_) {
             drive_fault_ = true;  // the stop ramp starts next period; amps drop now
             for (std::size_t j = 0; j < joint_count_; ++j) amp_enable_out_[j] = false;
         }
@@ -622,6 +627,35 @@ class Motion : public hal::Instance {
         joints_primed_ = true;
     }
 
+    // joint.N.min-limit / max-limit (LinuxCNC's [JOINT_N]MIN_LIMIT / MAX_LIMIT) on the joint
+    // commands after the inverse kinematics: the planner keeps the axes inside their limits,
+    // but a kinematics can take a motor past its travel from inside them (a CoreXY motor runs
+    // X + Y). A command beyond a limit and further out than last period's trips a limit fault:
+    // the fault stop, program abandoned. A joint standing outside (after a reset) may move back.
+    // Reads the params every period, like the velocity limits. The caller drops the amps.
+    void check_joint_limits(bool enabled, std::int32_t line) noexcept {
+        if (!enabled || limit_fault_) return;
+        for (std::size_t j = 0; j < joint_count_; ++j) {
+            const double cmd_mm = joint_cmd_mm_[j];
+            const double step_mm = cmd_mm - joint_prev_mm_[j];
+            const double min_mm = joint_min_limit_[j].get(), max_mm = joint_max_limit_[j].get();
+            const bool out_high = cmd_mm > max_mm + kJointLimitRoundingMm && step_mm > 0;
+            const bool out_low = cmd_mm < min_mm - kJointLimitRoundingMm && step_mm < 0;
+            if (!(out_high || out_low)) continue;
+            limit_fault_ = true;
+            FaultReport report{FaultCause::JointSoftLimit, static_cast<int>(j), line, {}};
+            report.amount = cmd_mm;
+            report.min_mm = min_mm;
+            report.max_mm = max_mm;
+            note_fault(report);
+            return;
+        }
+    }
+
+    // A path planned along a joint limit (a CoreXY line of constant X + Y on motor A's limit)
+    // sums sampled axes that can round a few ulps past it.
+    static constexpr double kJointLimitRoundingMm = 1e-9;
+
     // Relative slack for sampling: backward differences of an exactly limited profile can read
     // a hair above the limit.
     static constexpr double kJointLimitSlack = 1e-3;
@@ -726,6 +760,18 @@ class Motion : public hal::Instance {
                     "program abandoned",
                     feeder_ ? feeder_->program_file() : program_path_, r.line, r.action.number,
                     r.joint, r.amount);
+            case FaultCause::JointSoftLimit: {
+                // A joint that drives A, B or C turns (degrees).
+                const int axis = kins_.kins().joint_axes()[static_cast<std::size_t>(r.joint)];
+                const char* unit = axis >= 3 && axis <= 5 ? "deg" : "mm";
+                return fmt::format(
+                    "{}:{}: joint {} commanded to {:.4f} {}, beyond its soft limit [{:g}, {:g}] {} "
+                    "({}); motion stopped, program abandoned",
+                    feeder_ ? feeder_->program_file() : program_path_, r.line, r.joint, r.amount,
+                    unit, r.min_mm, r.max_mm, unit,
+                    pin_name(fmt::format("joint.{}.{}-limit", r.joint,
+                                         r.amount > r.max_mm ? "max" : "min")));
+            }
             case FaultCause::KinsLost:
                 return fmt::format(
                     "the kinematics kins={} was unloaded while motion used it; motion stopped, "
@@ -938,6 +984,11 @@ class Motion : public hal::Instance {
                                                        joint_count_};
     hal::Array<hal::Param<double>> joint_max_acceleration_{
         this, pin("joint.{}.max-acceleration"), joint_count_};
+    // LinuxCNC's [JOINT_N]MIN_LIMIT / MAX_LIMIT and its defaults for a joint without them.
+    hal::Array<hal::Param<double>> joint_min_limit_{this, pin("joint.{}.min-limit"), joint_count_,
+                                                    -1e99};
+    hal::Array<hal::Param<double>> joint_max_limit_{this, pin("joint.{}.max-limit"), joint_count_,
+                                                    1e99};
     hal::Array<hal::In<bool>> pos_lim_sw_in_{this, pin("joint.{}.pos-lim-sw-in"), joint_count_};
     hal::Array<hal::In<bool>> neg_lim_sw_in_{this, pin("joint.{}.neg-lim-sw-in"), joint_count_};
     // Published for LinuxCNC HAL files; homing is not implemented yet, so nothing reads it.
