@@ -307,11 +307,11 @@ Element make_parabola(const AxisArray& corner, const AxisArray& t1, const AxisAr
     return make_bezier(p0, p1, p2, p3);
 }
 
-Element trim_arc(const Element& arc, double from, double to) noexcept {
+Element trim_arc(const Element& arc, double from, double to, const AxisArray* end_mm) noexcept {
     Element e = arc;
     double len = arc.length_mm;
     double keep = std::max(0.0, len - from - to);
-    if (to > 0) e.end = point_at(arc, len - to);
+    if (to > 0) e.end = end_mm ? *end_mm : point_at(arc, len - to);
     // origin holds the centre in the plane and the start's values off it (c is zero in-plane).
     double f0 = from / len;
     for (int k = 0; k < kAxes; ++k) e.origin[k] = arc.origin[k] + f0 * arc.c[k];
@@ -389,22 +389,33 @@ constexpr double kChordSlackShare = 0.02;
 constexpr int kMaxSplitDepth = 6;
 
 // Sets moving[k] for every axis e changes anywhere (and leaves the others as they were).
+// The bits of x without its sign: 0 exactly when x == 0 (+0 or -0), nonzero for NaN too.
+std::uint64_t magnitude_bits(double x) {
+    std::uint64_t u;
+    std::memcpy(&u, &x, sizeof u);
+    return u << 1;
+}
+
 void mark_moving_axes(const Element& e, std::array<bool, kAxes>& moving) {
+    // x != 0 as integer tests and | rather than ||: no branch per axis.
     switch (e.kind) {
         case ElementKind::Line:
-            for (int k = 0; k < kAxes; ++k) moving[k] = moving[k] || e.a[k] != 0;
+            for (int k = 0; k < kAxes; ++k) moving[k] = moving[k] | (magnitude_bits(e.a[k]) != 0);
             return;
         case ElementKind::Arc:
             for (int k = 0; k < kAxes; ++k)
-                moving[k] = moving[k] || e.a[k] != 0 || e.b[k] != 0 || e.c[k] != 0;
+                moving[k] = moving[k] | ((magnitude_bits(e.a[k]) | magnitude_bits(e.b[k]) |
+                                          magnitude_bits(e.c[k])) != 0);
             return;
         case ElementKind::Blend:
-            for (int k = 0; k < kAxes; ++k) moving[k] = moving[k] || e.a[k] != 0 || e.b[k] != 0;
+            for (int k = 0; k < kAxes; ++k)
+                moving[k] =
+                    moving[k] | ((magnitude_bits(e.a[k]) | magnitude_bits(e.b[k])) != 0);
             return;
         case ElementKind::Bezier:
             for (int k = 0; k < kAxes; ++k)
-                moving[k] = moving[k] || e.a[k] != e.origin[k] || e.b[k] != e.origin[k] ||
-                            e.end[k] != e.origin[k];
+                moving[k] = moving[k] | (e.a[k] != e.origin[k]) | (e.b[k] != e.origin[k]) |
+                            (e.end[k] != e.origin[k]);
             return;
     }
     moving.fill(true);
@@ -581,7 +592,7 @@ bool bezier_within(const BezierPoints& bezier, const CornerPath& path, double li
     for (int k = 0; k < kAxes; ++k) {
         if (path.moving[k]) continue;
         const double x0 = bezier.p0[k];
-        if (bezier.p1[k] != x0 || bezier.p2[k] != x0 || bezier.p3[k] != x0) {
+        if ((bezier.p1[k] != x0) | (bezier.p2[k] != x0) | (bezier.p3[k] != x0)) {
             piece[0][dims] = bezier.p0[k] - path.fixed[k];
             piece[1][dims] = bezier.p1[k] - path.fixed[k];
             piece[2][dims] = bezier.p2[k] - path.fixed[k];

@@ -277,9 +277,12 @@ double max_trim_mm(const Element& e, double trimmed_start_mm) {
                                        : std::min(left, e.length_mm * kMaxArcTrimShare);
 }
 
-Element trimmed(const Element& e, double from_mm, double to_mm) {
+// arc_end_mm: where an arc ends once trimmed, if already known (see trim_arc).
+Element trimmed(const Element& e, double from_mm, double to_mm,
+                const AxisArray* arc_end_mm = nullptr) {
     if (from_mm <= 0 && to_mm <= 0) return e;
-    return e.kind == ElementKind::Line ? trim_line(e, from_mm, to_mm) : trim_arc(e, from_mm, to_mm);
+    return e.kind == ElementKind::Line ? trim_line(e, from_mm, to_mm)
+                                       : trim_arc(e, from_mm, to_mm, arc_end_mm);
 }
 
 }  // namespace
@@ -350,7 +353,9 @@ Planner::Junction Planner::bezier_corner(const Piece& p, const Piece& next, doub
 void Planner::close_piece(Piece& p, Piece* next) {
     Junction jn = next ? classify(p, *next) : Junction{0, false, 0};
     bool rough = p.rough_start || jn.rough;
-    Element e = trimmed(p.geom, p.trim_start_mm, jn.blend_l_mm);
+    // A Bezier corner starts where the move is cut (bezier_corner evaluated it there).
+    Element e = trimmed(p.geom, p.trim_start_mm, jn.blend_l_mm,
+                        jn.blend == Blend::Curve ? &jn.curve.origin : nullptr);
     // Only a line blended at both ends can vanish, and its junctions are smooth.
     if (e.length_mm > kMinLength_mm) add_item(e, p.feed_mm_s, jn.cap_mm_s, rough, p, p.rapid);
     if (!next) return;
@@ -388,8 +393,7 @@ void Planner::close_piece(Piece& p, Piece* next) {
 
 void Planner::add_item(const Element& e, double feed, double end_cap, bool rough,
                        const Piece& owner, bool rapid, double blend_centripetal) {
-    Item& it = items_.emplace_back();
-    it.geom = e;
+    Item& it = items_.emplace_back(e);
     it.bounds = bounds(e);
     double cut = reserve_ + (rough ? cfg_.junction_share : 0);
     it.lim = element_limits(e, it.bounds, cfg_.limits, feed, {1 - cut, 1 - cut, blend_centripetal});

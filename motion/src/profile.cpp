@@ -145,9 +145,11 @@ Profile1D build_profile(double length, double v_in, double v_out, double vcap,
     auto needed = [&](double vp) {
         return ramp_distance_mm(v_in, vp, lim) + ramp_distance_mm(vp, v_out, lim);
     };
+    double needed_at_cap = 0;  // needed(vcap), when vpeak stays at the cap
+    bool at_cap = false;
     if (vpeak <= lo) {
         vpeak = lo;
-    } else if (needed(vpeak) > length) {
+    } else if ((needed_at_cap = needed(vpeak)) > length) {
         if (!jerk_limited(lim)) {
             double a = lim.acc_mm_s2;
             vpeak = std::sqrt((2 * a * length + v_in * v_in + v_out * v_out) / 2);
@@ -155,11 +157,13 @@ Profile1D build_profile(double length, double v_in, double v_out, double vcap,
         } else {
             vpeak = peak_speed_for_length(length, v_in, v_out, lo, vpeak, lim);
         }
+    } else {
+        at_cap = true;
     }
     PhaseWriter w(prof);
     w.start(v_in);
     w.ramp(v_in, vpeak, lim);
-    double cruise_mm = length - needed(vpeak);
+    double cruise_mm = length - (at_cap ? needed_at_cap : needed(vpeak));
     if (vpeak > 0 && cruise_mm > 0) w.cruise(cruise_mm / vpeak);
     w.ramp(vpeak, v_out, lim);
     prof.duration_s = w.time();

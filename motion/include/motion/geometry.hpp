@@ -102,7 +102,9 @@ Element make_parabola(const AxisArray& corner, const AxisArray& t1, const AxisAr
 
 // The arc element trimmed to [from_mm, length - to_mm] of the original (same circle, helix
 // pitch and direction).
-Element trim_arc(const Element& arc, double from_mm, double to_mm) noexcept;
+// end_mm: the arc's point at length - to_mm (point_at) if the caller has it already.
+Element trim_arc(const Element& arc, double from_mm, double to_mm,
+                 const AxisArray* end_mm = nullptr) noexcept;
 
 // The line element trimmed to [from_mm, length - to_mm] of the original.
 Element trim_line(const Element& line, double from_mm, double to_mm) noexcept;

@@ -82,6 +82,9 @@ class Planner {
         bool rough_start = false;  // the junction at its start is not smooth
     };
     struct Item {
+        // Built in place in items_ from its element: value-initialising it first would clear
+        // all of it only for add_item() to overwrite it.
+        explicit Item(const Element& e) : geom(e) {}
         Element geom;
         ElementBounds bounds;  // bounds(geom), kept for the rate caps when it is emitted
         ElementLimits lim;
