@@ -178,7 +178,7 @@ void BlockRun::move_arc(bool ccw) {
     const AxisVec centre_m = to_machine(centre_prog, offset);
     const AxisVec end_m = to_machine(end, offset);
 
-    canon::Arc arc;
+    canon::Arc& arc = emit_arc();
     arc.plane = mp;
     arc.end_mm = end_m;
     arc.centre_mm = {centre_m[0], centre_m[1], centre_m[2]};
@@ -186,7 +186,6 @@ void BlockRun::move_arc(bool ccw) {
     const bool machine_ccw = ccw != flipped;
     arc.turns = (1 + extra_turns) * (machine_ccw ? 1 : -1);
     arc.flags = flags_;
-    emit(arc);
     st.pos.machine_mm = end_m;
     st.pos.prog_mm = end;
 }

@@ -131,6 +131,16 @@ class BlockRun {
             st.moved_since_sync = st.moved = true;
         out_.push_back(Canon{b_.loc, CanonCommand(std::forward<T>(cmd))});
     }
+    // emit() for an arc, returning the command to fill where it is stored: an Arc filled field by
+    // field in a local and then copied whole stalled on store forwarding (a tenth of an arc
+    // block's cycles). Call it after the block's last check (a rejected block's commands are
+    // dropped, but a half-filled one should never be seen).
+    canon::Arc& emit_arc() {
+        st.moved_since_sync = st.moved = true;
+        Canon& c = out_.emplace_back();
+        c.loc = b_.loc;
+        return c.cmd.emplace<canon::Arc>();
+    }
     const ProgramTransform& xf() const { return xf_copy ? *xf_copy : base_xf_; }
     ProgramTransform& xf_mut() {
         if (!xf_copy) xf_copy = base_xf_;
