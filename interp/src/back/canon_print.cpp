@@ -332,7 +332,9 @@ void SummarySink::arc(const canon::Arc& a) {
                         pos_[pa.normal]);
     }
     extend(a.end_mm[0], a.end_mm[1], a.end_mm[2]);
-    const double len = std::hypot(r * sweep, a.end_mm[pa.normal] - pos_[pa.normal]);
+    // A plane arc (most arcs) skips hypot: hypot(x, ±0) is |x| exactly (C Annex F).
+    const double dn = a.end_mm[pa.normal] - pos_[pa.normal];
+    const double len = dn == 0 ? std::abs(r * sweep) : std::hypot(r * sweep, dn);
     feed_len_ += len;
     if (feed_mm_s_ > 0) feed_time_ += len / feed_mm_s_;
     pos_ = a.end_mm;
