@@ -69,6 +69,9 @@ struct AxisPins {
     int axis;  // index into motion::AxisArray
     std::unique_ptr<hal::Out<double>> pos_cmd;
     std::unique_ptr<hal::Out<double>> pos_fb;  // forward kinematics of the joint feedback
+    // Machine coordinate minus the planner's frame (M902): a jump of pos-cmd by a change of
+    // it is no motion, and readers of pos-cmd (cnc run's figures) subtract it.
+    std::unique_ptr<hal::Out<double>> home_shift;
     std::unique_ptr<hal::Param<double>> max_velocity;
     std::unique_ptr<hal::Param<double>> max_acceleration;
     std::unique_ptr<hal::Param<double>> max_jerk;
@@ -230,7 +233,10 @@ class Motion : public hal::Instance {
         if (enabled) run_pending_action(s.line, p.s);
 
         // Machine coordinates: the planner's frame plus the shifts M902 has set.
-        for (const AxisPins& a : axes_) *a.pos_cmd = s.pos_mm[a.axis] + home_shift_mm_[a.axis];
+        for (const AxisPins& a : axes_) {
+            *a.pos_cmd = s.pos_mm[a.axis] + home_shift_mm_[a.axis];
+            *a.home_shift = home_shift_mm_[a.axis];
+        }
         check_kinematics();  // after the actions: a tool offset set now applies now
         kins_.kins().inverse(s.pos_mm, joint_cmd_mm_);
         check_joint_limits(enabled, s.line);  // before check_joint_motion moves joint_prev_mm_
@@ -917,6 +923,7 @@ class Motion : public hal::Instance {
             a.axis = k;
             a.pos_cmd = std::make_unique<hal::Out<double>>(this, stem + ".pos-cmd");
             a.pos_fb = std::make_unique<hal::Out<double>>(this, stem + ".pos-fb");
+            a.home_shift = std::make_unique<hal::Out<double>>(this, stem + ".home-shift");
             a.max_velocity =
                 std::make_unique<hal::Param<double>>(this, stem + ".max-velocity", 100.0);
             a.max_acceleration =

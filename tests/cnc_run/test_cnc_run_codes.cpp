@@ -81,4 +81,19 @@ TEST(CncRunCodes, M801IsPrintedWhenReachedAndWarningsOnce) {
         << r.err;
 }
 
+// M902 H0 at X10 makes that point X0 without moving: the drives (wired from motion's joint
+// commands) must not see the coordinate jump, and the summary counts only real motion.
+TEST(CncRunCodes, M902SetsTheMachineCoordinateWithoutMovingTheDrives) {
+    ScratchDir scratch;
+    const RunResult r =
+        run_on_mill(scratch, "G90 G21\nG1 X10 F600\nG906\nM902 H0\nG1 X5\nM30\n");
+    ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+    EXPECT_NE(r.out.find("errors: none"), std::string::npos) << r.out;
+    // why: X10 became X0, so X5 is 5 mm further on, at machine X5 (motor at 15).
+    EXPECT_NEAR(cnc_test::summary_axes(r.out, "final position (mm)").at(0), 5, 1e-4) << r.out;
+    // why: 10 mm, then 5 mm; the 10 mm jump of the coordinate is neither path nor speed.
+    EXPECT_NEAR(cnc_test::summary_number(r.out, "path length"), 15, 1e-3) << r.out;
+    EXPECT_NEAR(cnc_test::summary_axes(r.out, "max velocity (mm/s)").at(0), 10, 1e-3) << r.out;
+}
+
 }  // namespace

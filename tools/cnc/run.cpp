@@ -207,6 +207,7 @@ struct MachinePins {
     std::optional<Probe> interp_done;
     // motion.program-paused (M00, M01 with the optional-stop switch, single block); read live.
     std::optional<Probe> paused;
+    std::vector<std::optional<Probe>> axis_home_shift;  // axis.L.home-shift, where motion has it
 };
 
 MachinePins find_pins(hal::Runtime& rt, const std::string& ini, const std::string& letters) {
@@ -226,11 +227,13 @@ MachinePins find_pins(hal::Runtime& rt, const std::string& ini, const std::strin
                   {},
                   {},
                   try_probe(rt, "interp.done"),
-                  try_probe(rt, "motion.program-paused")};
+                  try_probe(rt, "motion.program-paused"),
+                  {}};
     for (char l : letters) {
         if (auto probe = try_probe(rt, fmt::format("axis.{}.pos-cmd", l))) {
             p.letters += l;
             p.axis_cmd.push_back(*probe);
+            p.axis_home_shift.push_back(try_probe(rt, fmt::format("axis.{}.home-shift", l)));
         }
     }
     for (int j = 0;; ++j) {
@@ -249,6 +252,7 @@ struct Sample {
     double t_s = 0;
     int line = 0;
     std::vector<double> axis_mm, joint_fb_mm, ferror_mm;
+    std::vector<double> motion_frame_mm;  // axis_mm less the M902 shifts: what actually moved
     double vel_mm_s = 0;
     bool in_position = false, fault = false, enabled = false;
     bool program_done = true;  // interp.done (true without the interp component)
@@ -258,7 +262,12 @@ void read_sample(const MachinePins& p, double t_s, Sample& s) {
     s.t_s = t_s;
     s.line = static_cast<int>(p.line.number());
     s.axis_mm.resize(p.axis_cmd.size());
-    for (std::size_t k = 0; k < p.axis_cmd.size(); ++k) s.axis_mm[k] = p.axis_cmd[k].number();
+    s.motion_frame_mm.resize(p.axis_cmd.size());
+    for (std::size_t k = 0; k < p.axis_cmd.size(); ++k) {
+        s.axis_mm[k] = p.axis_cmd[k].number();
+        const auto& shift = p.axis_home_shift[k];
+        s.motion_frame_mm[k] = s.axis_mm[k] - (shift ? shift->number() : 0.0);
+    }
     s.joint_fb_mm.resize(p.joint_fb.size());
     s.ferror_mm.resize(p.ferror.size());
     for (std::size_t j = 0; j < p.ferror.size(); ++j) {
@@ -291,7 +300,7 @@ class Stats {
         if (!prev_pos_.empty()) {
             double d2 = 0;
             for (std::size_t k = 0; k < letters_.size(); ++k) {
-                const double d = s.axis_mm[k] - prev_pos_[k];
+                const double d = s.motion_frame_mm[k] - prev_pos_[k];
                 if (is_linear(letters_[k])) d2 += d * d;
                 if (!every_cycle_) continue;
                 const double v = d / period_s_;
@@ -301,7 +310,7 @@ class Stats {
             }
             path_mm_ += std::sqrt(d2);
         }
-        prev_pos_ = s.axis_mm;
+        prev_pos_ = s.motion_frame_mm;
     }
 
     void print(std::FILE* out) const {
@@ -678,6 +687,13 @@ class CycleStream {
             names.push_back("interp.done");
             cfg += 'b';
         }
+        // The M902 shifts too, after interp.done, when they fit (see shift_fields); else they
+        // are read live, which may misplace an M902's jump by the loop's lag.
+        if (has_all_shifts(p) && names.size() == f_without_done(p) + (p.interp_done ? 1 : 0) &&
+            names.size() + p.letters.size() <= hal::kMaxStreamFields) {
+            for (char l : p.letters) names.push_back(fmt::format("axis.{}.home-shift", l));
+            cfg += std::string(p.letters.size(), 'f');
+        }
         const std::string thread = servo_thread(s);
         if (thread.empty() || names.size() > hal::kMaxStreamFields) return nullptr;
         s.exec({"loadrt", "sampler", "names=" + std::string(kName), "cfg=" + cfg,
@@ -717,6 +733,11 @@ class CycleStream {
         s.fault = record_[f++].b;
         s.enabled = record_[f++].b;
         s.program_done = has_done_ ? record_[f++].b : done_after(cycles_);
+        s.motion_frame_mm = s.axis_mm;
+        for (std::size_t k = 0; k < axes_; ++k) {
+            const auto& live = pins_.axis_home_shift[k];
+            s.motion_frame_mm[k] -= has_shifts_ ? record_[f++].f : live ? live->number() : 0.0;
+        }
     }
 
     // Cycles lost because the loop fell more than the stream's depth behind.
@@ -734,7 +755,10 @@ class CycleStream {
           axes_(p.letters.size()),
           joints_(p.ferror.size()),
           has_done_(p.interp_done.has_value() && ring->fields > f_without_done(p)),
+          has_shifts_(ring->fields == f_without_done(p) + (has_done_ ? 1 : 0) + axes_ &&
+                      axes_ > 0 && (has_done_ || !p.interp_done)),
           done_probe_(p.interp_done ? &*p.interp_done : nullptr),
+          pins_(p),
           record_(ring->fields) {}
 
     // interp.done read live for a record that does not carry it: true only for cycles sampled
@@ -751,6 +775,11 @@ class CycleStream {
     // and the three motion bits.
     static std::size_t f_without_done(const MachinePins& p) {
         return 1 + p.letters.size() + 2 * p.ferror.size() + 1 + 3;
+    }
+
+    static bool has_all_shifts(const MachinePins& p) {
+        return std::all_of(p.axis_home_shift.begin(), p.axis_home_shift.end(),
+                           [](const auto& probe) { return probe.has_value(); });
     }
 
     // The thread motion-controller runs in: servo-thread by LinuxCNC's convention, or the
@@ -780,7 +809,9 @@ class CycleStream {
     double period_s_;
     std::size_t axes_, joints_;
     bool has_done_;
+    bool has_shifts_;  // axis.L.home-shift in the record
     const Probe* done_probe_;  // read live when interp.done is not in the record
+    const MachinePins& pins_;  // outlives the stream (both belong to one run)
     long done_from_cycle_ = -1;
     std::vector<hal::Value> record_;
     long cycles_ = 0;
