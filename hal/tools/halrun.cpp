@@ -9,6 +9,7 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <filesystem>
 #include <mutex>
 #include <thread>
 
@@ -98,7 +99,13 @@ int main(int argc, char** argv) {
         hal::Server server(runtime, request_quit);
         hal::LocalBackend backend(runtime);
         hal::Script script(backend);
-        if (!ini.empty()) script.load_ini(ini);
+        if (!ini.empty()) {
+            script.load_ini(ini);
+            // LinuxCNC's launcher exports the INI's path; HAL files pass it on as
+            // $(INI_FILE_NAME) (e.g. halfiles/interp.hal), so `halrun -i` provides it too.
+            if (!std::getenv("INI_FILE_NAME"))
+                setenv("INI_FILE_NAME", std::filesystem::absolute(ini).c_str(), 1);
+        }
 
         int status = 0;
         if (!file.empty() && !script.run_file(file)) status = 1;
