@@ -505,7 +505,9 @@ std::string describe_fault(const MachinePins& p, const Sample& s) {
             return fmt::format("following error on joint {}: {:.4f} mm, over its limit {} mm", j,
                                s.ferror_mm[j], p.ferror_limit[j].number());
     }
-    return "motion fault (the planner's message follows when motion stops)";
+    // Limit switches, joint soft limits, kinematics faults: motion prints the cause itself
+    // (`motion.0: file:line: ...` on stderr, at the stop).
+    return "motion fault (the cause is in motion's message on stderr)";
 }
 
 // The instance this process owns, torn down on every path out.
