@@ -102,8 +102,9 @@ inline Options read_ini(const hal::IniFile& ini) {
     for (const ini_detail::Key& k : ini_detail::kKeys)
         if (const auto* e = ini.find("RS274NGC", k.name)) k.apply(*e, o);
     if (o.use_default_speed && o.default_feed_mm_min <= 0)
-        ini_detail::bad_value(*ini.find("RS274NGC", "USE_DEFAULT_SPEED"),
-                              "needs [RS274NGC]DEFAULT_FEED_MM_MIN, the feed moves then run at");
+        ini_detail::bad_value(
+            *ini.find("RS274NGC", "USE_DEFAULT_SPEED"),
+            "needs [RS274NGC]DEFAULT_FEED_MM_MIN > 0, the speed every feed move then runs at");
     return o;
 }
 

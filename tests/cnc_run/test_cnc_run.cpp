@@ -344,17 +344,10 @@ namespace {
 // section when empty).
 std::string mill_ini_with(const std::string& section, const std::string& key,
                           const std::string& value) {
-    std::istringstream in(slurp(fs::path(CNC_SOURCE_DIR) / "configs/sim/mill.ini"));
-    std::string text, line, current;
-    while (std::getline(in, line)) {
-        if (line.rfind('[', 0) == 0) current = line.substr(1, line.find(']') - 1);
-        if (line.rfind("HALFILE = ", 0) == 0)
-            line = fmt::format("HALFILE = {}/configs/sim/{}", CNC_SOURCE_DIR, line.substr(10));
+    return cnc_test::sim_ini("mill", [&](const std::string& current, std::string& line) {
         if (line.rfind(key + " = ", 0) == 0 && (section.empty() || section == current))
             line = key + " = " + value;
-        text += line + "\n";
-    }
-    return text;
+    });
 }
 
 TEST(CncRunErrors, FollowingErrorTripNamesLineAndJoint) {

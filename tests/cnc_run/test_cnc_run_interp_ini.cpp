@@ -28,16 +28,11 @@ using cnc_test::slurp;
 // configs/sim/mill.ini with its HAL files named by absolute path and `rs274ngc` (lines) added
 // at the top of its [RS274NGC] section.
 fs::path mill_ini_with(const fs::path& dir, const std::string& rs274ngc) {
-    std::istringstream in(slurp(fs::path(CNC_SOURCE_DIR) / "configs/sim/mill.ini"));
-    std::string text, line;
-    while (std::getline(in, line)) {
-        if (line.rfind("HALFILE = ", 0) == 0)
-            line = fmt::format("HALFILE = {}/configs/sim/{}", CNC_SOURCE_DIR, line.substr(10));
-        text += line + "\n";
-        if (line == "[RS274NGC]") text += rs274ngc;
-    }
+    const std::string lines = rs274ngc.substr(0, rs274ngc.find_last_not_of('\n') + 1);
     const fs::path ini = dir / "machine.ini";
-    std::ofstream(ini) << text;
+    std::ofstream(ini) << cnc_test::sim_ini("mill", [&](const std::string&, std::string& line) {
+        if (line == "[RS274NGC]" && !lines.empty()) line += "\n" + lines;
+    });
     return ini;
 }
 
@@ -121,9 +116,10 @@ TEST(CncRunInterpIni, TheSwitchWithoutADefaultFeedIsRefused) {
     const RunResult r =
         run_cnc(fmt::format("'{}' examples/pocket.ngc --sim-clock", ini.string()), scratch.path());
     EXPECT_EQ(r.exit_code, 2);
-    EXPECT_EQ(r.err, ini.string() +
-                         ":17: [RS274NGC]USE_DEFAULT_SPEED = 1: needs "
-                         "[RS274NGC]DEFAULT_FEED_MM_MIN, the feed moves then run at\n");
+    EXPECT_EQ(r.err,
+              ini.string() +
+                  ":17: [RS274NGC]USE_DEFAULT_SPEED = 1: needs "
+                  "[RS274NGC]DEFAULT_FEED_MM_MIN > 0, the speed every feed move then runs at\n");
 }
 
 }  // namespace

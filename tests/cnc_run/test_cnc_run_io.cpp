@@ -24,17 +24,10 @@ using cnc_test::slurp;
 
 // configs/sim/mill.ini with its HAL files named by absolute path, plus `extra_hal` loaded last.
 std::string mill_ini_plus(const fs::path& extra_hal) {
-    std::istringstream in(slurp(fs::path(CNC_SOURCE_DIR) / "configs/sim/mill.ini"));
-    std::string text, line;
-    while (std::getline(in, line)) {
-        if (line.rfind("HALFILE = ", 0) == 0) {
-            line = fmt::format("HALFILE = {}/configs/sim/{}", CNC_SOURCE_DIR, line.substr(10));
-            if (line.find("io-loopback.hal") != std::string::npos)
-                line += fmt::format("\nHALFILE = {}", extra_hal.string());
-        }
-        text += line + "\n";
-    }
-    return text;
+    return cnc_test::sim_ini("mill", [&](const std::string&, std::string& line) {
+        if (line.rfind("HALFILE = ", 0) == 0 && line.find("io-loopback.hal") != std::string::npos)
+            line += "\nHALFILE = " + extra_hal.string();
+    });
 }
 
 // A tool setter under the spindle: input 3 (dio-in-03) closes while Z is below `z_mm`.

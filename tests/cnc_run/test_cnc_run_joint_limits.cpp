@@ -22,16 +22,9 @@ using cnc_test::ScratchDir;
 
 // corexy.ini with its HAL files by absolute path and [JOINT_0] MAX_LIMIT = 400.
 std::string corexy_ini_with_short_motor_a() {
-    std::istringstream in(cnc_test::slurp(fs::path(CNC_SOURCE_DIR) / "configs/sim/corexy.ini"));
-    std::string text, line, section;
-    while (std::getline(in, line)) {
-        if (line.rfind('[', 0) == 0) section = line.substr(1, line.find(']') - 1);
-        if (line.rfind("HALFILE = ", 0) == 0)
-            line = fmt::format("HALFILE = {}/configs/sim/{}", CNC_SOURCE_DIR, line.substr(10));
+    return cnc_test::sim_ini("corexy", [](const std::string& section, std::string& line) {
         if (section == "JOINT_0" && line.rfind("MAX_LIMIT = ", 0) == 0) line = "MAX_LIMIT = 400";
-        text += line + "\n";
-    }
-    return text;
+    });
 }
 
 RunResult run_on_short_corexy(const ScratchDir& scratch, const fs::path& prog) {

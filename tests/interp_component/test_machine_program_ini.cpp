@@ -119,8 +119,8 @@ TEST(MachineProgramIni, OneTestPerErrorMessage) {
               "m.ini:4: [RS274NGC]S_HOOK_PROGRAM = 12.5: expected a program number (a whole "
               "number, 1 to 99999999)");
     EXPECT_EQ(error_of("DEFAULT_FEED_MM_MIN = 0\nUSE_DEFAULT_SPEED = 1\n"),
-              "m.ini:5: [RS274NGC]USE_DEFAULT_SPEED = 1: needs [RS274NGC]DEFAULT_FEED_MM_MIN, the "
-              "feed moves then run at");
+              "m.ini:5: [RS274NGC]USE_DEFAULT_SPEED = 1: needs [RS274NGC]DEFAULT_FEED_MM_MIN > 0, "
+              "the speed every feed move then runs at");
     EXPECT_EQ(error_of("G00_Z_SPLIT = nan\n"),
               "m.ini:4: [RS274NGC]G00_Z_SPLIT = nan: expected 0 or 1");
     EXPECT_EQ(error_of("ARC_TOLERANCE_MM = inf\n"),

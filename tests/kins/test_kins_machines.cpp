@@ -26,26 +26,15 @@ struct Edit {
     std::string key, value;
 };
 
-// configs/sim/NAME.ini with the HAL files and HALLIB by absolute path and the edits applied.
+// configs/sim/NAME.ini (paths absolute, see cnc_test::sim_ini) with the edits applied.
 std::string ini_with(const std::string& name, const std::vector<Edit>& edits) {
-    const fs::path dir = fs::path(CNC_SOURCE_DIR) / "configs/sim";
-    std::istringstream in(slurp(dir / (name + ".ini")));
-    std::string text, line, section;
-    while (std::getline(in, line)) {
-        if (line.rfind('[', 0) == 0) section = line.substr(1, line.find(']') - 1);
-        if (line.rfind("HALFILE = ", 0) == 0 || line.rfind("HALLIB = ", 0) == 0 ||
-            line.rfind("TOOL_TABLE = ", 0) == 0 || line.rfind("PARAMETER_FILE = ", 0) == 0) {
-            const auto eq = line.find(" = ");
-            line = fmt::format("{} = {}/{}", line.substr(0, eq), dir.string(), line.substr(eq + 3));
-        }
+    return cnc_test::sim_ini(name, [&](const std::string& section, std::string& line) {
         for (const Edit& e : edits) {
             const bool here =
                 e.section.back() == '_' ? section.rfind(e.section, 0) == 0 : section == e.section;
             if (here && line.rfind(e.key + " = ", 0) == 0) line = e.key + " = " + e.value;
         }
-        text += line + "\n";
-    }
-    return text;
+    });
 }
 
 // "j0 0.0000  j1 2.4000 ..." of the summary -> {0.0, 2.4, ...}

@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -51,6 +52,30 @@ struct RunResult {
     int exit_code = -1;
     std::string out, err;
 };
+
+// An edit of one line of a copied sim config: the line's section ("" before the first) and
+// the line, which the edit may change or extend ("\n" then more lines).
+using IniEdit = std::function<void(const std::string& section, std::string& line)>;
+
+// configs/sim/NAME.ini as text, with the paths it gives relative to its folder (HALFILE,
+// HALLIB, TOOL_TABLE, PARAMETER_FILE) made absolute, so the copy runs from a scratch folder,
+// and `edit` applied to every line.
+inline std::string sim_ini(const std::string& name, const IniEdit& edit = {}) {
+    const fs::path dir = fs::path(CNC_SOURCE_DIR) / "configs/sim";
+    std::istringstream in(slurp(dir / (name + ".ini")));
+    std::string text, line, section;
+    while (std::getline(in, line)) {
+        if (line.rfind('[', 0) == 0) section = line.substr(1, line.find(']') - 1);
+        for (const char* key : {"HALFILE", "HALLIB", "TOOL_TABLE", "PARAMETER_FILE"}) {
+            const std::string prefix = std::string(key) + " = ";
+            if (line.rfind(prefix, 0) == 0)
+                line = prefix + (dir / line.substr(prefix.size())).string();
+        }
+        if (edit) edit(section, line);
+        text += line + "\n";
+    }
+    return text;
+}
 
 // `cnc run ARGS` in `cwd`; stdout and stderr go through files in `scratch`.
 inline RunResult run_cnc(const std::string& args, const fs::path& scratch,
