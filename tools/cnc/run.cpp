@@ -759,7 +759,6 @@ class CycleStream {
           has_done_(p.interp_done.has_value() && ring->fields > f_without_done(p)),
           has_shifts_(ring->fields == f_without_done(p) + (has_done_ ? 1 : 0) + axes_ &&
                       axes_ > 0 && (has_done_ || !p.interp_done)),
-          done_probe_(p.interp_done ? &*p.interp_done : nullptr),
           pins_(p),
           record_(ring->fields) {}
 
@@ -767,8 +766,8 @@ class CycleStream {
     // after the loop first saw it TRUE (a stop at a queue-busting read just before the end
     // must not pass for the end). May end a run a few cycles late, never early.
     bool done_after(long cycle) {
-        if (!done_probe_) return true;
-        if (done_from_cycle_ < 0 && done_probe_->bit())
+        if (!pins_.interp_done) return true;
+        if (done_from_cycle_ < 0 && pins_.interp_done->bit())
             done_from_cycle_ = cycles_ + static_cast<long>(ring_->used());
         return done_from_cycle_ >= 0 && cycle > done_from_cycle_;
     }
@@ -812,8 +811,9 @@ class CycleStream {
     std::size_t axes_, joints_;
     bool has_done_;
     bool has_shifts_;  // axis.L.home-shift in the record
-    const Probe* done_probe_;  // read live when interp.done is not in the record
-    const MachinePins& pins_;  // outlives the stream (both belong to one run)
+    // Outlives the stream (both belong to one run); interp.done and the M902 shifts are read
+    // live from it when the record does not carry them.
+    const MachinePins& pins_;
     long done_from_cycle_ = -1;
     std::vector<hal::Value> record_;
     long cycles_ = 0;
