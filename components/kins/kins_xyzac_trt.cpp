@@ -40,9 +40,13 @@ class TrtSource final : public motion::KinematicsSource {
 
   private:
     void copy_params(motion::Kinematics& k) const noexcept override {
+        copy_params_with_tool_offset(k, tool_offset_);
+    }
+    void copy_params_with_tool_offset(motion::Kinematics& k,
+                                      double tool_offset_mm) const noexcept override {
         motion::TrtPivots p;
         p.c_pivot_mm = {x_rot_point_, y_rot_point_, 0.0};
-        p.a_pivot_mm = {0.0, y_rot_point_ + y_offset_, z_rot_point_ + z_offset_ + tool_offset_};
+        p.a_pivot_mm = {0.0, y_rot_point_ + y_offset_, z_rot_point_ + z_offset_ + tool_offset_mm};
         static_cast<motion::XyzacTrtKinematics&>(k).set_pivots(p);  // k came from make()
     }
 

@@ -130,6 +130,21 @@ bool KinsLink::keep_first_joints_of_identity(std::size_t n) {
     return true;
 }
 
+std::unique_ptr<PlanningKinematics> KinsLink::planning_copy() const {
+    // Trivial kinematics have no parameters, and keep_first_joints_of_identity() may have cut
+    // the module's nine joints down: build the same joint list directly.
+    if (source_ && kins_->name() != "trivial") {
+        std::unique_ptr<motion::Kinematics> k = source_->make();
+        source_->refresh(*k);  // an unloaded instance leaves make()'s defaults, like kins()
+        return std::make_unique<PlanningKinematics>(source_, std::move(k));
+    }
+    // The same joint-to-axis list (a gantry's XYYZ included).
+    std::string letters;
+    for (int axis : kins_->joint_axes()) letters += "XYZABCUVW"[axis];
+    return std::make_unique<PlanningKinematics>(
+        nullptr, std::make_unique<motion::TrivialKinematics>(letters));
+}
+
 KinsLink::KinsLink(KinsLink&& o) noexcept
     : name_(std::move(o.name_)),
       library_(o.library_),

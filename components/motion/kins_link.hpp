@@ -12,6 +12,27 @@
 
 namespace motioncomp {
 
+// The machine's kinematics for the non-realtime planner thread: an object of its own, since the
+// servo thread's (KinsLink::kins()) is refreshed from the module's pins every period. Its
+// parameters are the module's at the time it was made, except the tool length, which follows
+// the program (set_tool_offset) rather than the pin the servo side changes when the move runs.
+class PlanningKinematics {
+  public:
+    PlanningKinematics(std::shared_ptr<const motion::KinematicsSource> source,
+                       std::unique_ptr<motion::Kinematics> kins)
+        : source_(std::move(source)), kins_(std::move(kins)) {}
+    const motion::Kinematics& kins() const noexcept { return *kins_; }
+    // The tool length offset in Z (G43/G49) the moves planned from now on run with: what motion
+    // writes on motion.tooloffset.z, which a TRT config nets to the kinematics' tool-offset.
+    void set_tool_offset(double tool_offset_mm) noexcept {
+        if (source_) source_->refresh_with_tool_offset(*kins_, tool_offset_mm);
+    }
+
+  private:
+    std::shared_ptr<const motion::KinematicsSource> source_;  // null: the built-in kinematics
+    std::unique_ptr<motion::Kinematics> kins_;
+};
+
 class KinsLink {
   public:
     // Configuration world; both throw hal::Error with the reason.
@@ -32,6 +53,9 @@ class KinsLink {
     // Realtime: reads the module's parameters (pivots, tool offset) into kins(). False once
     // the module's instance has been unloaded (kins() keeps the last parameters).
     bool refresh() noexcept { return !source_ || source_->refresh(*kins_); }
+    // Configuration world: a second kinematics of this machine with the module's current
+    // parameters, for the planner thread.
+    std::unique_ptr<PlanningKinematics> planning_copy() const;
     // "trivial" or the name of the instance used.
     const std::string& name() const noexcept { return name_; }
     // True when a loaded kinematics instance computes the joints, false for the built-in one.

@@ -10,7 +10,9 @@
 // machine's kinematics (kins_link.hpp: built-in trivial, or the kins_* module named by kins=)
 // to joint.N.motor-pos-cmd, and the joint feedback back through forward() to axis.L.pos-fb.
 // Following errors, limit switches, joint velocity/acceleration and the joint soft limits are
-// per joint; the axis soft limits are checked by the planner.
+// per joint. The planner thread refuses a move whose path leaves the axis soft limits, or takes
+// a joint past its soft limit (through a kinematics of its own, joint_limits.hpp), before it
+// starts; the servo function checks the joint commands again as the last line of defence.
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -886,7 +888,9 @@ class Motion : public hal::Instance {
         return static_cast<std::size_t>(n);
     }
 
-    // Soft limits and I/O counts, read at start() like the planner's limits.
+    // Soft limits and I/O counts, read at start() like the planner's limits. The joint limits
+    // are checked again every servo period (check_joint_limits), with the params as they are
+    // then.
     motioncomp::SinkConfig sink_config() const {
         motioncomp::SinkConfig c;
         c.min_limit_mm.fill(-1e99);
@@ -899,6 +903,16 @@ class Motion : public hal::Instance {
                                              name(), kLowerAxes[a.axis], c.min_limit_mm[a.axis],
                                              c.max_limit_mm[a.axis]));
         }
+        c.joints.kins = kins_.planning_copy();
+        for (std::size_t j = 0; j < joint_count_; ++j) {
+            c.joints.min_limit.push_back(joint_min_limit_[j].get());
+            c.joints.max_limit.push_back(joint_max_limit_[j].get());
+            if (!(c.joints.min_limit[j] <= c.joints.max_limit[j]))
+                throw hal::Error(fmt::format("{}: joint.{}: min-limit {} is above max-limit {}",
+                                             name(), j, c.joints.min_limit[j],
+                                             c.joints.max_limit[j]));
+        }
+        c.joints.pin_stem = pin_name("joint");
         c.digital_outputs = static_cast<int>(num_dio_);
         c.digital_inputs = static_cast<int>(num_dio_);
         return c;

@@ -4,13 +4,18 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <variant>
 
 #include "canon_geometry.hpp"
 #include "interp/canon.hpp"
+#include "joint_limits.hpp"
+#include "kins_link.hpp"
+#include "motion/geometry.hpp"
 #include "program_feeder.hpp"
 
 namespace motioncomp {
@@ -46,7 +51,11 @@ double orient_angle_deg(const Orient& o) {
 class Sink final : public PlanSink {
   public:
     Sink(motion::Planner& planner, const FeederConfig& cfg, ProgramFeeder& feeder)
-        : planner_(planner), cfg_(cfg), feeder_(feeder), pos_mm_(planner.end_position()) {}
+        : planner_(planner),
+          cfg_(cfg),
+          feeder_(feeder),
+          pos_mm_(planner.end_position()),
+          joint_check_(cfg.machine.joints) {}
 
     void emit(const interp::Canon& c) override {
         std::visit([&](const auto& cmd) { handle(c.loc, cmd); }, c.cmd);
@@ -168,6 +177,7 @@ class Sink final : public PlanSink {
     // on motion.tooloffset.z for a kinematics that must know it (kins_xyzac_trt's tool-offset).
     void handle(const interp::SourceLoc& loc, const interp::canon::ToolOffset& t) {
         queue(loc, {motion::ActionKind::ToolOffset, false, 0, t.offset_mm[2]});
+        joint_check_.set_tool_offset(t.offset_mm[2]);
     }
     // M10 / M11 (V5.4; the 6th edition sends a warning instead): spindle.0.clamp.
     void handle(const interp::SourceLoc& loc, const interp::canon::SpindleClamp& c) {
@@ -341,20 +351,64 @@ class Sink final : public PlanSink {
         }
     }
 
+    // The joints along the move's path (joint_limits.hpp), before the planner has it: a move
+    // that would take a motor past its travel is refused at its line, and the machine comes to
+    // rest where the move before ended.
+    void check_joint_limits(const interp::SourceLoc& loc, const motion::PathSegment& seg) {
+        if (!joint_check_.config().kins) return;
+        const motion::Element path = seg.kind == motion::SegmentKind::Arc
+                                         ? motion::make_arc(pos_mm_, seg)
+                                         : motion::make_line(pos_mm_, seg.end_mm);
+        const std::optional<JointViolation> v = joint_check_.check(path);
+        if (!v) return;
+        const JointLimitConfig& jc = joint_check_.config();
+        const auto joint = static_cast<std::size_t>(v->joint);
+        // A joint that drives A, B or C turns (degrees).
+        const int axis = jc.kins->kins().joint_axes()[joint];
+        const char* unit = axis >= 3 && axis <= 5 ? "deg" : "mm";
+        const motion::AxisArray at = to_machine(v->at_mm);
+        std::string where;
+        for (int k = 0; k < motion::kAxes; ++k)
+            if (cfg_.axis_present[k])
+                where += fmt::format("{}{}{}", where.empty() ? "" : " ", kAxisLetters[k],
+                                     interp::fmt_num(at[k]));
+        throw std::runtime_error(fmt::format(
+            "{}:{}:{}: joint {} would move to {} {} (axis position {}), beyond its soft limit "
+            "[{:g}, {:g}] {} ({}.{}.{}-limit); the move is refused before it starts",
+            loc.file, loc.line, loc.col, v->joint,
+            position_text(v->position, v->above ? jc.max_limit[joint] : jc.min_limit[joint]), unit,
+            where, jc.min_limit[joint], jc.max_limit[joint], unit, jc.pin_stem, v->joint,
+            v->above ? "max" : "min"));
+    }
+
+    // Four decimals, or as many as it takes to show the position beyond `limit`.
+    static std::string position_text(double pos, double limit) {
+        std::string text = interp::fmt_num(pos);
+        const double shown = std::strtod(text.c_str(), nullptr);
+        if ((pos > limit) != (shown > limit) || (pos < limit) != (shown < limit))
+            text = fmt::format("{:.12g}", pos);
+        return text;
+    }
+
+    // PlanError says "line N: reason"; the user needs the file too.
+    [[noreturn]] static void rethrow_with_file(const interp::SourceLoc& loc,
+                                               const motion::PlanError& e) {
+        std::string reason = e.what();
+        const auto colon = reason.find(": ");
+        if (colon != std::string::npos) reason.erase(0, colon + 2);
+        throw std::runtime_error(fmt::format("{}:{}:{}: {}", loc.file, loc.line, loc.col, reason));
+    }
+
     void push(const interp::SourceLoc& loc, const motion::PathSegment& seg) {
         check_soft_limits(loc, seg);
-        // The look-ahead closed (M802 P196609): the block before ends at rest first.
-        if (buffer_closed_ && seg.line != last_move_line_) rest(nullptr);
-        last_move_line_ = seg.line;
         try {
+            check_joint_limits(loc, seg);
+            // The look-ahead closed (M802 P196609): the block before ends at rest first.
+            if (buffer_closed_ && seg.line != last_move_line_) rest(nullptr);
+            last_move_line_ = seg.line;
             planner_.push(seg);
         } catch (const motion::PlanError& e) {
-            // PlanError says "line N: reason"; the user needs the file too.
-            std::string reason = e.what();
-            const auto colon = reason.find(": ");
-            if (colon != std::string::npos) reason.erase(0, colon + 2);
-            throw std::runtime_error(
-                fmt::format("{}:{}:{}: {}", loc.file, loc.line, loc.col, reason));
+            rethrow_with_file(loc, e);
         }
         pos_mm_ = seg.end_mm;
         feeder_.collect();
@@ -375,6 +429,7 @@ class Sink final : public PlanSink {
     bool limits_masked_ = false;    // between M802 P131072 and P131073
     std::int32_t last_move_line_ = -1;
     std::set<std::int64_t> unhandled_codes_;  // M802 codes already warned about
+    JointLimitCheck joint_check_;
 
     // M802 P values (S0 §3.10; FEATURES M802-1).
     static constexpr std::int64_t kMaskLimits = 0x20000;     // 131072

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "interp/canon.hpp"
+#include "joint_limits.hpp"
 #include "motion/planner.hpp"
 
 namespace motioncomp {
@@ -19,6 +20,7 @@ class ProgramFeeder;
 struct SinkConfig {
     motion::AxisArray min_limit_mm{};  // soft limits per axis (LinuxCNC axis.L.min-limit)
     motion::AxisArray max_limit_mm{};
+    JointLimitConfig joints;  // joint soft limits, checked through the kinematics
     int digital_outputs = 4;  // motion.digital-out-NN count (num_dio=)
     int digital_inputs = 4;
 };

@@ -121,12 +121,26 @@ class KinematicsSource {
         copy_params(k);
         return true;
     }
+    // Any thread, for a kinematics `k` of the caller's own (never the one a servo function
+    // refreshes): refresh() with `tool_offset_mm` in place of the instance's tool length input,
+    // so a planner can map a move through the kinematics with the tool offset (G43) it will run
+    // with. A kinematics without a tool length ignores it. Returns false, touching nothing, once
+    // the instance has been unloaded.
+    bool refresh_with_tool_offset(Kinematics& k, double tool_offset_mm) const noexcept {
+        if (!attached_.load(std::memory_order_acquire)) return false;
+        copy_params_with_tool_offset(k, tool_offset_mm);
+        return true;
+    }
     // Configuration world: called by the instance's destructor, before its pins go.
     void detach() noexcept { attached_.store(false, std::memory_order_release); }
 
   protected:
     // Realtime: reads the pins into `k` (a kinematics from make()). Default: no parameters.
     virtual void copy_params(Kinematics&) const noexcept {}
+    // As copy_params(), with the tool length given instead of read. Default: copy_params().
+    virtual void copy_params_with_tool_offset(Kinematics& k, double) const noexcept {
+        copy_params(k);
+    }
 
   private:
     std::atomic<bool> attached_{true};
@@ -135,7 +149,8 @@ class KinematicsSource {
 // The C entry point every kinematics .so exports beside cnc_hal_component:
 //     extern "C" const motion::KinematicsModule* cnc_kinematics_module();
 inline constexpr char kKinematicsEntryPoint[] = "cnc_kinematics_module";
-inline constexpr std::uint32_t kKinematicsAbiVersion = 1;
+// 2: KinematicsSource gained copy_params_with_tool_offset (its vtable changed).
+inline constexpr std::uint32_t kKinematicsAbiVersion = 2;
 
 struct KinematicsModule {
     std::uint32_t abi_version;  // first, and kept first by every future version

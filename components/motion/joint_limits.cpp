@@ -1,0 +1,158 @@
+#include "joint_limits.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <span>
+#include <stdexcept>
+
+#include "kins_link.hpp"
+
+namespace motioncomp {
+
+namespace {
+
+// Piece sizes within which a joint is close to a parabola (see the header).
+constexpr double kPieceSweepRad = std::numbers::pi / 6;  // 30 degrees of arc
+constexpr double kPieceRotaryDeg = 10;                   // of A, B or C travel
+constexpr int kMaxPieces = 1 << 16;                      // a 650 000-degree C move stays cheap
+// Allowance for the curvature between samples, as a multiple of the midpoint deviation.
+constexpr double kCurvatureFactor = 2;
+// Below this midpoint deviation an interval is not halved again: the bound of the check.
+constexpr double kLeafDeviation = 1e-6;
+constexpr int kMaxDepth = 40;
+// Rounding of the inverse kinematics (the servo check's kJointLimitRoundingMm).
+constexpr double kRounding = 1e-9;
+constexpr int kFirstRotary = 3, kLastRotary = 5;  // A, B, C
+
+int piece_count(const motion::Element& e, const motion::AxisArray& start) {
+    double pieces = 1;
+    if (e.kind == motion::ElementKind::Arc)
+        pieces = std::max(pieces, std::ceil(std::fabs(e.sweep_rad) / kPieceSweepRad));
+    for (int k = kFirstRotary; k <= kLastRotary; ++k)
+        pieces = std::max(pieces, std::ceil(std::fabs(e.end[k] - start[k]) / kPieceRotaryDeg));
+    return static_cast<int>(std::min(pieces, static_cast<double>(kMaxPieces)));
+}
+
+}  // namespace
+
+JointLimitCheck::JointLimitCheck(JointLimitConfig cfg) : cfg_(std::move(cfg)) {
+    if (!cfg_.kins) return;
+    joints_ = cfg_.kins->kins().joint_count();
+    if (joints_ > kMaxJoints)
+        throw std::invalid_argument("the kinematics has " + std::to_string(joints_) +
+                                    " joints; motion checks at most " + std::to_string(kMaxJoints));
+    if (cfg_.min_limit.size() != joints_ || cfg_.max_limit.size() != joints_)
+        throw std::invalid_argument("joint limits given for another number of joints");
+}
+
+void JointLimitCheck::set_tool_offset(double tool_offset_mm) noexcept {
+    if (cfg_.kins) cfg_.kins->set_tool_offset(tool_offset_mm);
+}
+
+void JointLimitCheck::joints_at(const motion::Element& e, double s_mm, Joints& out) const noexcept {
+    cfg_.kins->kins().inverse(motion::point_at(e, s_mm), std::span<double>(out.data(), joints_));
+}
+
+// Inside means within [min - allowance, max + allowance] plus rounding, the allowance being the
+// start's own distance outside, except at the end, which must be inside. NaN is outside.
+std::optional<JointViolation> JointLimitCheck::beyond(const motion::Element& e, double s_mm,
+                                                      const Joints& j, bool at_end) const noexcept {
+    for (std::size_t n = 0; n < joints_; ++n) {
+        const double above = at_end ? 0 : allow_above_[n];
+        const double below = at_end ? 0 : allow_below_[n];
+        const bool high = !(j[n] <= cfg_.max_limit[n] + above + kRounding);
+        const bool low = !(j[n] >= cfg_.min_limit[n] - below - kRounding);
+        if (!high && !low) continue;
+        return JointViolation{static_cast<int>(n), j[n], high, motion::point_at(e, s_mm)};
+    }
+    return std::nullopt;
+}
+
+std::optional<JointViolation> JointLimitCheck::refine(const motion::Element& e, double s0,
+                                                      const Joints& j0, double s1, const Joints& j1,
+                                                      int depth) const noexcept {
+    const double sm = 0.5 * (s0 + s1);
+    Joints jm;
+    joints_at(e, sm, jm);
+    if (auto v = beyond(e, sm, jm, false)) return v;
+    bool cleared = true;
+    for (std::size_t n = 0; n < joints_ && cleared; ++n) {
+        const double d = std::fabs(jm[n] - 0.5 * (j0[n] + j1[n]));
+        if (d < kLeafDeviation) continue;  // samples inside: within the bound of the check
+        const double hi = std::max({j0[n], j1[n], jm[n]}) + kCurvatureFactor * d;
+        const double lo = std::min({j0[n], j1[n], jm[n]}) - kCurvatureFactor * d;
+        cleared = hi <= cfg_.max_limit[n] + allow_above_[n] + kRounding &&
+                  lo >= cfg_.min_limit[n] - allow_below_[n] - kRounding;
+    }
+    if (cleared || depth >= kMaxDepth) return std::nullopt;
+    if (auto v = refine(e, s0, j0, sm, jm, depth + 1)) return v;
+    return refine(e, sm, jm, s1, j1, depth + 1);
+}
+
+// The point of the path where joint v.joint is farthest beyond the limit v found it past: what
+// the message names. Only for a refused move, so it may take its time: a scan of 32 samples
+// per piece, then a golden-section search next to the best one.
+JointViolation JointLimitCheck::farthest(const motion::Element& e, int pieces,
+                                         const JointViolation& v) const noexcept {
+    const auto n = static_cast<std::size_t>(v.joint);
+    const double sign = v.above ? 1 : -1;
+    Joints j;
+    auto excess = [&](double s) {
+        joints_at(e, s, j);
+        return sign * j[n];
+    };
+    const int samples = 32 * pieces;
+    const double h = e.length_mm / samples;
+    double best_s = 0, best = -INFINITY;
+    for (int i = 1; i <= samples; ++i) {
+        const double s = i == samples ? e.length_mm : h * i;
+        if (const double x = excess(s); x > best) {
+            best = x;
+            best_s = s;
+        }
+    }
+    constexpr double kGolden = 0.6180339887498949;
+    double lo = std::max(0.0, best_s - h), hi = std::min(e.length_mm, best_s + h);
+    for (int i = 0; i < 60 && hi - lo > 1e-12 * e.length_mm; ++i) {
+        const double a = hi - kGolden * (hi - lo), b = lo + kGolden * (hi - lo);
+        if (excess(a) > excess(b))
+            hi = b;
+        else
+            lo = a;
+    }
+    const double mid = 0.5 * (lo + hi);
+    if (const double x = excess(mid); x > best) {
+        best = x;
+        best_s = mid;
+    }
+    JointViolation out = v;
+    if (!(best > sign * v.position)) return out;  // NaN, or no farther point found
+    out.position = sign * best;
+    out.at_mm = motion::point_at(e, best_s);
+    return out;
+}
+
+std::optional<JointViolation> JointLimitCheck::check(const motion::Element& e) {
+    if (!cfg_.kins || !(e.length_mm > 0)) return std::nullopt;
+    Joints j0, j1;
+    joints_at(e, 0, j0);
+    for (std::size_t n = 0; n < joints_; ++n) {
+        allow_above_[n] = std::max(0.0, j0[n] - cfg_.max_limit[n]);
+        allow_below_[n] = std::max(0.0, cfg_.min_limit[n] - j0[n]);
+    }
+    const int pieces = piece_count(e, motion::point_at(e, 0));
+    double s0 = 0;
+    for (int i = 1; i <= pieces; ++i) {
+        const double s1 = i == pieces ? e.length_mm : e.length_mm * i / pieces;
+        joints_at(e, s1, j1);
+        auto v = beyond(e, s1, j1, i == pieces);
+        if (!v) v = refine(e, s0, j0, s1, j1, 0);
+        if (v) return farthest(e, pieces, *v);
+        s0 = s1;
+        j0 = j1;
+    }
+    return std::nullopt;
+}
+
+}  // namespace motioncomp

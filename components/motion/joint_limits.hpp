@@ -1,0 +1,89 @@
+// Joint soft limits at plan time: the path of a programmed move, mapped through the machine's
+// kinematics, against joint.N.min-limit / max-limit, before the move is given to the planner.
+// The servo function checks every joint command again (motion.cpp, the last line of defence);
+// this check is what turns "a program the machine cannot run" into an error naming its line
+// before the machine moves there. Runs on the feeder thread, with a kinematics of its own.
+//
+// How the path is sampled (the bound). A joint along a move is a smooth function f(s) of the
+// path length. The move is cut into pieces of at most 30 degrees of arc and 10 degrees of
+// rotary-axis travel (A, B, C), so that on a piece f is close to a parabola; each piece is then
+// halved where needed. On an interval with end values f0, f1 and middle value fm, the deviation
+// d = fm - (f0 + f1) / 2 measures its curvature: a parabola exceeds its largest sample by at
+// most |d|, and the check allows for 2 |d| (the curvature may double across a piece). An
+// interval whose samples plus 2 |d| stay within the limits is cleared; one that does not is
+// halved, until a sample lies beyond a limit (refused) or |d| < 1e-6 mm (or degree), when it is
+// cleared with its samples inside: a joint may then pass its limit between samples by at most
+// 2e-6. A line under a kinematics that is linear in the axes (trivial, gantry, CoreXY, and TRT
+// with its rotary axes still) has d = 0: its end points decide exactly, from three inverse calls.
+//
+// Corner blends are not sampled: they lie inside the convex hull of their corner, which a
+// linear kinematics maps inside the joint limits when both moves are. Under a kinematics with
+// rotary axes a blend within the tolerance of a move that rides on a joint limit can pass it
+// by about the tolerance; the servo check stops the machine then.
+//
+// A machine standing outside a joint limit (after a reset) may move back in, as for the axis
+// limits: points on the way may be as far out as the start, the end must be inside.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "motion/geometry.hpp"
+#include "motion/types.hpp"
+
+namespace motioncomp {
+
+class PlanningKinematics;
+
+// The joint side of what the sink checks a program against, from motion's params at start().
+struct JointLimitConfig {
+    std::shared_ptr<PlanningKinematics> kins;  // null: joints are not checked at plan time
+    std::vector<double> min_limit, max_limit;  // per joint, in its axis's unit (mm or degrees)
+    std::string pin_stem = "joint";            // for messages: <stem>.N.max-limit
+};
+
+// The point of a move's path where a joint would be farthest beyond its limit.
+struct JointViolation {
+    int joint = 0;
+    double position = 0;        // the joint's position there
+    bool above = false;         // past max-limit (else below min-limit)
+    motion::AxisArray at_mm{};  // the axes there, in the planner's frame
+};
+
+class JointLimitCheck {
+  public:
+    // LinuxCNC's limit on joints (EMCMOT_MAX_JOINTS).
+    static constexpr std::size_t kMaxJoints = 16;
+
+    // Throws std::invalid_argument for a kinematics with more than kMaxJoints joints or limit
+    // lists of another length.
+    explicit JointLimitCheck(JointLimitConfig cfg);
+
+    // A point of the path of `e` (a programmed line or arc, in the planner's frame) beyond a
+    // joint limit, or none. The start of the path is where the machine stands: it is not
+    // refused, only measured (see "A machine standing outside" above).
+    std::optional<JointViolation> check(const motion::Element& e);
+    // The tool length offset the moves from now on run with (G43/G49).
+    void set_tool_offset(double tool_offset_mm) noexcept;
+    const JointLimitConfig& config() const noexcept { return cfg_; }
+
+  private:
+    using Joints = std::array<double, kMaxJoints>;
+    void joints_at(const motion::Element& e, double s_mm, Joints& out) const noexcept;
+    std::optional<JointViolation> beyond(const motion::Element& e, double s_mm, const Joints& j,
+                                         bool at_end) const noexcept;
+    JointViolation farthest(const motion::Element& e, int pieces,
+                            const JointViolation& v) const noexcept;
+    std::optional<JointViolation> refine(const motion::Element& e, double s0, const Joints& j0,
+                                         double s1, const Joints& j1, int depth) const noexcept;
+
+    JointLimitConfig cfg_;
+    std::size_t joints_ = 0;
+    // How far the move's start lies beyond each limit (0 inside): what its points may reach.
+    Joints allow_above_{}, allow_below_{};
+};
+
+}  // namespace motioncomp
