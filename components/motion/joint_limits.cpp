@@ -13,7 +13,7 @@ namespace motioncomp {
 namespace {
 
 // Piece sizes within which a joint is close to a parabola (see the header).
-constexpr double kPieceSweepRad = std::numbers::pi / 6;  // 30 degrees of arc
+constexpr double kPieceSweepRad = std::numbers::pi / 2;  // 90 degrees of arc
 constexpr double kPieceRotaryDeg = 10;                   // of A, B or C travel
 constexpr int kMaxPieces = 1 << 16;                      // a 650 000-degree C move stays cheap
 // Allowance for the curvature between samples, as a multiple of the midpoint deviation.
@@ -48,6 +48,7 @@ JointLimitCheck::JointLimitCheck(JointLimitConfig cfg) : cfg_(std::move(cfg)) {
 
 void JointLimitCheck::set_tool_offset(double tool_offset_mm) noexcept {
     if (cfg_.kins) cfg_.kins->set_tool_offset(tool_offset_mm);
+    last_end_known_ = false;  // the same axes map to other joints now
 }
 
 void JointLimitCheck::joints_at(const motion::Element& e, double s_mm, Joints& out) const noexcept {
@@ -64,7 +65,7 @@ std::optional<JointViolation> JointLimitCheck::beyond(const motion::Element& e, 
         const bool high = !(j[n] <= cfg_.max_limit[n] + above + kRounding);
         const bool low = !(j[n] >= cfg_.min_limit[n] - below - kRounding);
         if (!high && !low) continue;
-        return JointViolation{static_cast<int>(n), j[n], high, motion::point_at(e, s_mm)};
+        return JointViolation{static_cast<int>(n), j[n], high, motion::point_at(e, s_mm), s_mm};
     }
     return std::nullopt;
 }
@@ -90,58 +91,68 @@ std::optional<JointViolation> JointLimitCheck::refine(const motion::Element& e, 
     return refine(e, sm, jm, s1, j1, depth + 1);
 }
 
-// The point of the path where joint v.joint is farthest beyond the limit v found it past: what
-// the message names. Only for a refused move, so it may take its time: a scan of 32 samples
-// per piece, then a golden-section search next to the best one.
+// The point of the path where joint v.joint is farthest beyond what the move was allowed (the
+// limit; points before the end also the start's own distance outside): what the message names.
+// Branch and bound with the same curvature allowance as the check (an interval can exceed its
+// samples by at most 2 |d|), from v's own point; only for a refused move.
 JointViolation JointLimitCheck::farthest(const motion::Element& e, int pieces,
                                          const JointViolation& v) const noexcept {
     const auto n = static_cast<std::size_t>(v.joint);
     const double sign = v.above ? 1 : -1;
+    const double limit = v.above ? cfg_.max_limit[n] : cfg_.min_limit[n];
+    const double allow = v.above ? allow_above_[n] : allow_below_[n];
     Joints j;
-    auto excess = [&](double s) {
+    // How far beyond the limit, less the allowance every point but the end has.
+    auto beyond_by = [&](double s) {
         joints_at(e, s, j);
-        return sign * j[n];
+        return sign * (j[n] - limit) - allow;
     };
-    const int samples = 32 * pieces;
-    const double h = e.length_mm / samples;
-    double best_s = 0, best = -INFINITY;
-    for (int i = 1; i <= samples; ++i) {
-        const double s = i == samples ? e.length_mm : h * i;
-        if (const double x = excess(s); x > best) {
-            best = x;
-            best_s = s;
-        }
-    }
-    constexpr double kGolden = 0.6180339887498949;
-    double lo = std::max(0.0, best_s - h), hi = std::min(e.length_mm, best_s + h);
-    for (int i = 0; i < 60 && hi - lo > 1e-12 * e.length_mm; ++i) {
-        const double a = hi - kGolden * (hi - lo), b = lo + kGolden * (hi - lo);
-        if (excess(a) > excess(b))
-            hi = b;
-        else
-            lo = a;
-    }
-    const double mid = 0.5 * (lo + hi);
-    if (const double x = excess(mid); x > best) {
-        best = x;
-        best_s = mid;
+    Farthest f{v.s_mm, beyond_by(v.s_mm) + (v.s_mm < e.length_mm ? 0 : allow)};
+    if (const double at_end = beyond_by(e.length_mm) + allow; at_end > f.excess)
+        f = {e.length_mm, at_end};
+    double s0 = 0, g0 = beyond_by(0);
+    for (int i = 1; i <= pieces; ++i) {
+        const double s1 = i == pieces ? e.length_mm : e.length_mm * i / pieces;
+        const double g1 = beyond_by(s1);
+        maximise(e, beyond_by, s0, g0, s1, g1, 0, f);
+        s0 = s1;
+        g0 = g1;
     }
     JointViolation out = v;
-    if (!(best > sign * v.position)) return out;  // NaN, or no farther point found
-    out.position = sign * best;
-    out.at_mm = motion::point_at(e, best_s);
+    joints_at(e, f.s_mm, j);
+    out.position = j[n];
+    out.at_mm = motion::point_at(e, f.s_mm);
+    out.s_mm = f.s_mm;
     return out;
+}
+
+template <class Excess>
+void JointLimitCheck::maximise(const motion::Element& e, Excess& excess, double s0, double g0,
+                               double s1, double g1, int depth, Farthest& f) const noexcept {
+    const double sm = 0.5 * (s0 + s1);
+    const double gm = excess(sm);
+    if (gm > f.excess) f = {sm, gm};
+    const double d = std::fabs(gm - 0.5 * (g0 + g1));
+    if (std::max({g0, g1, gm}) + kCurvatureFactor * d <= f.excess + 1e-12) return;
+    if (depth >= 2 * kMaxDepth || s1 - s0 <= 1e-12 * e.length_mm) return;
+    maximise(e, excess, s0, g0, sm, gm, depth + 1, f);
+    maximise(e, excess, sm, gm, s1, g1, depth + 1, f);
 }
 
 std::optional<JointViolation> JointLimitCheck::check(const motion::Element& e) {
     if (!cfg_.kins || !(e.length_mm > 0)) return std::nullopt;
     Joints j0, j1;
-    joints_at(e, 0, j0);
+    const motion::AxisArray start = motion::point_at(e, 0);
+    // A move mostly starts where the last one checked ended: its joints are known.
+    if (last_end_known_ && start == last_end_mm_)
+        j0 = last_end_joints_;
+    else
+        cfg_.kins->kins().inverse(start, std::span<double>(j0.data(), joints_));
     for (std::size_t n = 0; n < joints_; ++n) {
         allow_above_[n] = std::max(0.0, j0[n] - cfg_.max_limit[n]);
         allow_below_[n] = std::max(0.0, cfg_.min_limit[n] - j0[n]);
     }
-    const int pieces = piece_count(e, motion::point_at(e, 0));
+    const int pieces = piece_count(e, start);
     double s0 = 0;
     for (int i = 1; i <= pieces; ++i) {
         const double s1 = i == pieces ? e.length_mm : e.length_mm * i / pieces;
@@ -152,6 +163,9 @@ std::optional<JointViolation> JointLimitCheck::check(const motion::Element& e) {
         s0 = s1;
         j0 = j1;
     }
+    last_end_mm_ = e.end;  // what point_at gives at the end of a line or an arc
+    last_end_joints_ = j0;
+    last_end_known_ = true;
     return std::nullopt;
 }
 

@@ -5,16 +5,19 @@
 // before the machine moves there. Runs on the feeder thread, with a kinematics of its own.
 //
 // How the path is sampled (the bound). A joint along a move is a smooth function f(s) of the
-// path length. The move is cut into pieces of at most 30 degrees of arc and 10 degrees of
+// path length. The move is cut into pieces of at most 90 degrees of arc and 10 degrees of
 // rotary-axis travel (A, B, C), so that on a piece f is close to a parabola; each piece is then
 // halved where needed. On an interval with end values f0, f1 and middle value fm, the deviation
 // d = fm - (f0 + f1) / 2 measures its curvature: a parabola exceeds its largest sample by at
-// most |d|, and the check allows for 2 |d| (the curvature may double across a piece). An
-// interval whose samples plus 2 |d| stay within the limits is cleared; one that does not is
-// halved, until a sample lies beyond a limit (refused) or |d| < 1e-6 mm (or degree), when it is
-// cleared with its samples inside: a joint may then pass its limit between samples by at most
-// 2e-6. A line under a kinematics that is linear in the axes (trivial, gantry, CoreXY, and TRT
-// with its rotary axes still) has d = 0: its end points decide exactly, from three inverse calls.
+// most |d|, and the check allows for 2 |d|. An arc through a kinematics linear in the axes
+// gives joints f = a cos(t - phi) + b t + c, which on a 90-degree piece exceed their samples by
+// at most 0.37 |d| (computed over phi and b); a rotation of 10 degrees or less is as close to
+// its parabola. An interval whose samples plus 2 |d| stay within the limits is cleared; one
+// that does not is halved, until a sample lies beyond a limit (refused) or |d| < 1e-6 mm (or
+// degree), when it is cleared with its samples inside: a joint may then pass its limit between
+// samples by at most 2e-6. A line under a kinematics that is linear in the axes (trivial,
+// gantry, CoreXY, and TRT with its rotary axes still) has d = 0: its end points decide exactly,
+// from two inverse calls (the start's joints are the last move's end's).
 //
 // Corner blends are not sampled: they lie inside the convex hull of their corner, which a
 // linear kinematics maps inside the joint limits when both moves are. Under a kinematics with
@@ -45,12 +48,14 @@ struct JointLimitConfig {
     std::string pin_stem = "joint";            // for messages: <stem>.N.max-limit
 };
 
-// The point of a move's path where a joint would be farthest beyond its limit.
+// The point of a move's path where a joint would be farthest beyond its limit (beyond what the
+// move is allowed: see "A machine standing outside" above).
 struct JointViolation {
     int joint = 0;
     double position = 0;        // the joint's position there
     bool above = false;         // past max-limit (else below min-limit)
     motion::AxisArray at_mm{};  // the axes there, in the planner's frame
+    double s_mm = 0;            // there along the path
 };
 
 class JointLimitCheck {
@@ -75,8 +80,14 @@ class JointLimitCheck {
     void joints_at(const motion::Element& e, double s_mm, Joints& out) const noexcept;
     std::optional<JointViolation> beyond(const motion::Element& e, double s_mm, const Joints& j,
                                          bool at_end) const noexcept;
+    struct Farthest {
+        double s_mm, excess;
+    };
     JointViolation farthest(const motion::Element& e, int pieces,
                             const JointViolation& v) const noexcept;
+    template <class Excess>
+    void maximise(const motion::Element& e, Excess& excess, double s0, double g0, double s1,
+                  double g1, int depth, Farthest& f) const noexcept;
     std::optional<JointViolation> refine(const motion::Element& e, double s0, const Joints& j0,
                                          double s1, const Joints& j1, int depth) const noexcept;
 
@@ -84,6 +95,10 @@ class JointLimitCheck {
     std::size_t joints_ = 0;
     // How far the move's start lies beyond each limit (0 inside): what its points may reach.
     Joints allow_above_{}, allow_below_{};
+    // The end of the last move cleared and its joints (with the tool offset then in force).
+    bool last_end_known_ = false;
+    motion::AxisArray last_end_mm_{};
+    Joints last_end_joints_{};
 };
 
 }  // namespace motioncomp
