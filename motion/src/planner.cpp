@@ -607,6 +607,7 @@ void Planner::emit(const Item& it, const Profile1D& prof) {
     rec.line = it.line;
     rec.move_id = it.move_id;
     rec.rapid = it.rapid;
+    rec.rough = it.rough;
     rec.seq = seq_++;
 }
 

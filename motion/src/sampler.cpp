@@ -15,6 +15,9 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kBlockBrakeShare = 0.8;
 // Without a jerk limit r'' is free; r' still ramps over this time so the rate stays smooth.
 constexpr double kRateRampS = 0.005;
+// With a jerk limit a rate this close above 1 counts as 1 (the plan's own rate): a backup's
+// brake, followed piece by piece, may land a rounding error above where it was computed to.
+constexpr double kPlannedRate = 1 + 1e-12;
 // Room cache entries filled per period ahead of need: more than the records a period can
 // finish at the highest rate on short segments (0.05 mm at 120 mm/s: 2.4), so the cache is warm
 // by the time the override rises, and the cost stays spread over the periods.
@@ -22,6 +25,37 @@ constexpr std::size_t kWarmRecordsPerPeriod = 8;
 
 bool is_action(const PreparedSegment& rec) noexcept {
     return rec.action.kind != ActionKind::None;
+}
+struct PhasePeaks {
+    double v_mm_s = 0, a_mm_s2 = 0;
+};
+
+// Largest |v| and |a| of one profile phase of duration t_s (v0 + a0 t + j t^2 / 2).
+PhasePeaks phase_peaks(const ProfilePhase& ph, double t_s) noexcept {
+    const double v0 = ph.v0_mm_s, a0 = ph.a0_mm_s2, j = ph.j_mm_s3;
+    double v = std::max(std::fabs(v0), std::fabs(v0 + a0 * t_s + j * t_s * t_s / 2));
+    if (j != 0) {
+        double t_turn = -a0 / j;
+        if (t_turn > 0 && t_turn < t_s) v = std::max(v, std::fabs(v0 - a0 * a0 / (2 * j)));
+    }
+    return {v, std::max(std::fabs(a0), std::fabs(a0 + j * t_s))};
+}
+
+// What one phase asks of axis k at r = 1: peak |velocity|, |acceleration| and |jerk| through
+// the element's derivative bounds, the last two never above what the plan keeps to (`keep` of
+// the limits: the planner's guarantee, tighter than the bounds on arcs).
+struct AxisUse {
+    double vel = 0, acc = 0, jerk = 0;
+};
+AxisUse axis_use(const ElementBounds& b, int k, const PhasePeaks& pk, double j_abs, double keep,
+                 const AxisLimits& lim) noexcept {
+    const double v = pk.v_mm_s, a = pk.a_mm_s2;
+    AxisUse u;
+    u.vel = v * b.g1[k];
+    u.acc = std::min(a * b.g1[k] + v * v * b.g2[k], keep * lim.acc_mm_s2[k]);
+    u.jerk = std::min(j_abs * b.g1[k] + 3 * v * a * b.g2[k] + v * v * v * b.g3[k],
+                      keep * lim.jerk_mm_s3[k]);
+    return u;
 }
 }  // namespace
 
@@ -183,10 +217,12 @@ double Sampler::rate_cap_ahead() const noexcept {
     }
     // Planned time that can pass before the rate could be brought down to 1: phases starting
     // within it must have their caps respected from now on.
+    // The bounds in use lately (the room-based ones, at least the fixed ones) set the reach.
+    const double vm = std::max(rl_.max_rate_per_s, last_limits_.max_rate_per_s);
+    const double am = std::max(rl_.max_rate_per_s2, last_limits_.max_rate_per_s2);
     double up = std::max(rd_, 0.0);
-    double over = std::max(0.0, r_ + up * up / (2 * rl_.max_rate_per_s2) - 1);
-    double t_down = up / rl_.max_rate_per_s2 + over / rl_.max_rate_per_s +
-                    rl_.max_rate_per_s / rl_.max_rate_per_s2;
+    double over = std::max(0.0, r_ + up * up / (2 * am) - 1);
+    double t_down = up / am + over / vm + vm / am;
     double horizon = tau_ + cfg_.max_rate * t_down;  // in the front record's time
     std::size_t n = std::min(ring_.size(), cfg_.lookahead_records);
     double cap = kInf, start = 0;  // start: planned time at which the record begins
@@ -206,63 +242,320 @@ double Sampler::rate_cap_ahead() const noexcept {
     return cap;
 }
 
-// Moves (r, r') towards (target, 0) for dt along the time-optimal path with |r'| and |r''|
-// bounded, integrating exactly over its constant-r'' pieces; returns the planned time passed.
-double Sampler::integrate_rate(double target, double dt, const RateLimits& lim) noexcept {
+namespace {
+struct RateState {
+    double r = 0, rd = 0;
+};
+
+// Follows one piece exactly (r'' constant); returns the planned time passed.
+double step_rate(RateState& s, const RatePiece& pc) noexcept {
+    const double h = pc.h, u = pc.u;
+    const double passed = s.r * h + s.rd * h * h / 2 + u * h * h * h / 6;
+    s.r += s.rd * h + u * h * h / 2;
+    s.rd += u * h;
+    if (pc.zero_rd) s.rd = 0;
+    if (pc.r_snap >= 0) s.r = pc.r_snap;
+    return passed;
+}
+
+// The time-optimal move of (r, r') towards (target, 0) with |r'| <= vm and |r''| <= am, as
+// constant-r'' pieces covering dt. An r' beyond vm (the bounds shrank) is first brought back.
+void rate_path(RateState s, double target, double dt, const RateLimits& lim,
+               RatePath& out) noexcept {
     const double vm = lim.max_rate_per_s, am = lim.max_rate_per_s2;
-    double passed = 0, left = dt;
-    for (int iter = 0; iter < 4 && left > 0; ++iter) {
-        double d = target - r_;
-        if (std::fabs(d) <= 1e-12 && std::fabs(rd_) <= 1e-9) {
-            r_ = target;
-            rd_ = 0;
-            rdd_ = 0;
-            passed += r_ * left;
+    double left = dt;
+    auto take = [&](const RatePiece& pc) {  // false when dt ends inside it
+        const double h = std::min(left, pc.h);
+        RatePiece part = pc;
+        if (h < pc.h) part = {pc.u, h, false, -1};
+        out.add(part);
+        step_rate(s, part);
+        left -= h;
+        return h == pc.h;
+    };
+    for (int iter = 0; iter < 6 && left > 0; ++iter) {
+        const double d = target - s.r;
+        if (std::fabs(d) <= 1e-12 && std::fabs(s.rd) <= 1e-9) {
+            take({0, 0, true, target});
             break;
         }
-        double stop = rd_ * std::fabs(rd_) / (2 * am);
-        double s = d - stop > 0 ? 1.0 : (d - stop < 0 ? -1.0 : (rd_ > 0 ? -1.0 : 1.0));
-        double vp = s * std::min(vm, std::sqrt(std::max(0.0, s * d * am + rd_ * rd_ / 2)));
-        double ta = std::max(0.0, (vp - rd_) / (s * am));
-        double da = (vp * vp - rd_ * rd_) / (2 * s * am);
-        double dc = vp * vp / (2 * s * am);
-        double tb = vp != 0 ? std::max(0.0, (d - da - dc) / vp) : 0.0;
-        double tc = std::fabs(vp) / am;
-        const double pieces[3][2] = {{s * am, ta}, {0, tb}, {-s * am, tc}};
-        bool finished = true;
-        for (const auto& pc : pieces) {
-            double u = pc[0], h = std::min(left, pc[1]);
-            passed += r_ * h + rd_ * h * h / 2 + u * h * h * h / 6;
-            r_ += rd_ * h + u * h * h / 2;
-            rd_ += u * h;
-            rdd_ = u;
-            left -= h;
-            if (h < pc[1]) {
-                finished = false;
-                break;
-            }
+        if (std::fabs(s.rd) > vm) {
+            const double sg = s.rd > 0 ? 1.0 : -1.0;
+            if (!take({-sg * am, (std::fabs(s.rd) - vm) / am, false, -1})) break;
+            s.rd = sg * vm;
+            continue;
         }
-        if (finished) {  // landed on the target: remove the rounding drift
-            r_ = target;
-            rd_ = 0;
-            rdd_ = 0;
+        const double stop = s.rd * std::fabs(s.rd) / (2 * am);
+        const double sg = d - stop > 0 ? 1.0 : (d - stop < 0 ? -1.0 : (s.rd > 0 ? -1.0 : 1.0));
+        const double vp = sg * std::min(vm, std::sqrt(std::max(0.0, sg * d * am + s.rd * s.rd / 2)));
+        const double ta = std::max(0.0, (vp - s.rd) / (sg * am));
+        const double da = (vp * vp - s.rd * s.rd) / (2 * sg * am);
+        const double dc = vp * vp / (2 * sg * am);
+        const double tb = vp != 0 ? std::max(0.0, (d - da - dc) / vp) : 0.0;
+        const double tc = std::fabs(vp) / am;
+        if (!take({sg * am, ta, false, -1}) || !take({0, tb, false, -1}) ||
+            !take({-sg * am, tc, false, -1}))
+            break;
+        take({0, 0, true, target});  // landed on the target: remove the rounding drift
+    }
+    if (left > 0) out.add({0, left, false, -1});
+}
+
+// The backup after a move: r' braked to 0 at |r''| = am, then, above 1, r brought down to 1
+// (|r'| <= vm, |r''| <= am) and held. False when the brake would take r below 0.
+bool brake_path(RateState s, const RateLimits& lim, RatePath& out) noexcept {
+    const double vm = lim.max_rate_per_s, am = lim.max_rate_per_s2;
+    if (s.rd != 0) {
+        out.add({s.rd > 0 ? -am : am, std::fabs(s.rd) / am, true, -1});
+        s.r += s.rd * std::fabs(s.rd) / (2 * am);
+    }
+    if (s.r < -1e-12) return false;
+    const double over = s.r - 1;
+    if (over <= 0) return true;
+    const double ramp_s = vm / am;
+    if (over <= vm * ramp_s) {
+        const double t = std::sqrt(over / am);
+        out.add({-am, t, false, -1});
+        out.add({am, t, true, 1.0});
+    } else {
+        out.add({-am, ramp_s, false, -1});
+        out.add({0, (over - vm * ramp_s) / vm, false, -1});
+        out.add({am, ramp_s, true, 1.0});
+    }
+    return true;
+}
+
+// The first `dt` of path (split where needed) into `head`; path keeps the rest.
+void split_path(RatePath& path, double dt, RatePath& head) noexcept {
+    RatePath rest;
+    double left = dt;
+    for (int i = 0; i < path.count; ++i) {
+        const RatePiece& pc = path.pieces[static_cast<std::size_t>(i)];
+        if (left <= 0) {
+            rest.add(pc);
+        } else if (pc.h <= left) {
+            head.add(pc);
+            left -= pc.h;
+        } else {
+            head.add({pc.u, left, false, -1});
+            rest.add({pc.u, pc.h - left, pc.zero_rd, pc.r_snap});
+            left = 0;
         }
     }
-    if (r_ < 0) r_ = 0;
+    if (left > 0) head.add({0, left, false, -1});  // the backup has ended: r held
+    path = rest;
+}
+}  // namespace
+
+// With a jerk limit: one period of the rate (module comment in sampler.hpp). The proposal is
+// the time-optimal move towards the target under the room ahead, tried again at a quarter of
+// it; it is taken only with a backup that rate_path_safe() accepts; else the period follows
+// the backup accepted before. By induction the state always has a checked backup: at rest
+// with r <= 1 and r' = 0 the empty one (hold).
+double Sampler::advance_rate_jerk(double target, double dt) noexcept {
+    if (rd_ == 0 && r_ == target && r_ <= kPlannedRate) {  // steady at or below the plan's rate
+        cert_.count = 0;
+        rdd_ = 0;
+        return r_ * dt;
+    }
+    const RateLimits room = jerk_room_limits(target, dt);
+    for (double scale : {1.0, 0.25}) {
+        const RateLimits lim{room.max_rate_per_s * scale, room.max_rate_per_s2 * scale};
+        RatePath move;
+        rate_path({r_, rd_}, target, dt, lim, move);
+        RateState end{r_, rd_};
+        for (int i = 0; i < move.count; ++i) step_rate(end, move.pieces[static_cast<std::size_t>(i)]);
+        RatePath backup;
+        if (!brake_path(end, lim, backup)) continue;
+        RatePath whole = move;
+        for (int i = 0; i < backup.count; ++i) whole.add(backup.pieces[static_cast<std::size_t>(i)]);
+        if (whole.count == RatePath::kMaxPieces || !rate_path_safe(whole)) continue;
+        cert_ = backup;
+        last_limits_ = lim;
+        return apply_rate(move);
+    }
+    RatePath head;
+    split_path(cert_, dt, head);
+    return apply_rate(head);
+}
+
+double Sampler::apply_rate(const RatePath& path) noexcept {
+    RateState s{r_, rd_};
+    double passed = 0, u = 0;
+    for (int i = 0; i < path.count; ++i) {
+        const RatePiece& pc = path.pieces[static_cast<std::size_t>(i)];
+        passed += step_rate(s, pc);
+        if (pc.h > 0) u = pc.u;
+        if (pc.zero_rd) u = 0;
+    }
+    r_ = std::max(s.r, 0.0);
+    rd_ = s.rd;
+    rdd_ = u;
     return std::max(passed, 0.0);
 }
 
+// Calls visit(rec, bounds, phase, duration) for every phase of the ring's motion records that
+// overlaps planned time [from, to] (the front record's time), in order, until visit returns
+// false (Walk::Stopped). Walk::Unknown: the ring (or the look-ahead) ends before `to`. `at`
+// carries where the walk may start between calls with rising `from` (the records wholly
+// before it are skipped for good) and the last record's derivative bounds.
+template <class Visit>
+Sampler::Walk Sampler::walk_phases(double from, double to, WalkFrom& at,
+                                   Visit&& visit) const noexcept {
+    const std::size_t n = std::min(ring_.size(), cfg_.lookahead_records);
+    double start = at.start_s;
+    for (std::size_t i = at.index; i < n && start <= to; ++i) {
+        const PreparedSegment& rec = ring_.peek(i);
+        const Profile1D& p = rec.profile;
+        if (start + p.duration_s < from && i == at.index) {
+            at.index = i + 1;
+            at.start_s = start + p.duration_s;
+        } else if (start + p.duration_s >= from && !is_action(rec)) {
+            if (at.rec != &rec) {
+                at.rec = &rec;
+                at.bounds = bounds(rec.geom);
+            }
+            for (int ph = 0; ph < p.count; ++ph) {
+                const double t0 = p.phases[ph].t0_s;
+                const double t1 = ph + 1 < p.count ? p.phases[ph + 1].t0_s : p.duration_s;
+                if (start + t1 < from || start + t0 > to) continue;
+                if (!visit(rec, at.bounds, p.phases[ph], t1 - t0)) return Walk::Stopped;
+            }
+        }
+        start += p.duration_s;
+        // The sampler comes to rest at a program end (or stands on an action) and restarts
+        // from rest with the rate reset: what the rate does beyond never moves anything.
+        if (rec.program_end) return Walk::Covered;
+    }
+    return start > to ? Walk::Covered : Walk::Unknown;
+}
+
+// Bounds for the proposal: the least room, over the stretch the move and its brake may cover,
+// left by each phase at the highest rate reached there: r' from the acceleration left beside
+// a r^2 and from half the jerk left beside j r^3 (the 3 a r r' term), r'' from the other half
+// (the v r'' term). Never below the fixed bounds (valid anywhere at r <= 1); only a proposal:
+// rate_path_safe() decides.
+RateLimits Sampler::jerk_room_limits(double target, double dt) const noexcept {
+    const double vm0 = last_limits_.max_rate_per_s, am0 = last_limits_.max_rate_per_s2;
+    // The highest rate the move and its brake may reach: r' at most vm0 more for that long.
+    double reach_s = dt + vm0 / am0;
+    const double up = std::max(rd_, 0.0);
+    const double r_hi =
+        std::min(cfg_.max_rate,
+                 std::max({r_, r_ + up * up / (2 * am0), std::min(target, r_ + vm0 * reach_s)}));
+    if (r_hi > 1) reach_s += (r_hi - 1) / vm0 + vm0 / am0;
+    const AxisLimits& lim = cfg_.limits;
+    const double js = cfg_.junction_share;
+    double vm = kInf, am = kInf;
+    auto visit = [&](const PreparedSegment& rec, const ElementBounds& b, const ProfilePhase& ph,
+                     double dur) {
+        const double keep = 1 - cfg_.override_reserve - (rec.rough ? js : 0);
+        const double free_a = 1 - (rec.rough ? js * r_hi : 0);
+        const double free_j = 1 - (rec.rough ? js * r_hi * r_hi : 0);
+        const PhasePeaks pk = phase_peaks(ph, dur);
+        for (int q = 0; q < b.axis_count; ++q) {
+            const int k = b.axes[q];
+            const AxisUse use = axis_use(b, k, pk, std::fabs(ph.j_mm_s3), keep, lim);
+            if (use.vel > 1e-12)
+                vm = std::min(vm, (free_a * lim.acc_mm_s2[k] - use.acc * r_hi * r_hi) / use.vel);
+            if (lim.jerk_mm_s3[k] <= 0) continue;
+            const double left = free_j * lim.jerk_mm_s3[k] - use.jerk * r_hi * r_hi * r_hi;
+            if (use.acc * r_hi > 1e-12) vm = std::min(vm, left / (2 * 3 * r_hi * use.acc));
+            if (use.vel > 1e-12) am = std::min(am, left / (2 * use.vel));
+        }
+        return true;
+    };
+    WalkFrom at;
+    if (walk_phases(tau_, tau_ + r_hi * reach_s, at, visit) == Walk::Unknown) {
+        vm = std::min(vm, rl_.max_rate_per_s);  // nothing is known beyond the ring
+        am = std::min(am, rl_.max_rate_per_s2);
+    }
+    // Where nothing moves any rate change fits; the ramps stay finite (kRateRampS) anyway.
+    vm = std::clamp(vm, rl_.max_rate_per_s, cfg_.max_rate / kRateRampS);
+    am = std::clamp(am, rl_.max_rate_per_s2, std::max(vm / kRateRampS, rl_.max_rate_per_s2));
+    return {vm, am};
+}
+
+// Whether following `path` from (tau_, r_, r_'), then holding the rate it ends at, keeps every
+// axis within its limits. Each piece covers planned time [tau, tau + dtau] with r and |r'| at
+// most their largest values over it (r is quadratic and r' linear in time on a piece). A piece
+// at a steady r <= 1 is a pure time scale of the plan: always fine. The path must end with
+// r' = 0 and r <= 1.
+bool Sampler::rate_path_safe(const RatePath& path) const noexcept {
+    RateState s{r_, rd_};
+    double tau = tau_;
+    WalkFrom at;
+    for (int i = 0; i < path.count; ++i) {
+        const RatePiece& pc = path.pieces[static_cast<std::size_t>(i)];
+        const double r1 = s.r + s.rd * pc.h + pc.u * pc.h * pc.h / 2;
+        const double rd1 = s.rd + pc.u * pc.h;
+        double r_hi = std::max(s.r, r1), r_lo = std::min(s.r, r1);
+        if (pc.u != 0 && (s.rd > 0) != (rd1 > 0)) {  // r turns inside the piece
+            const double r_turn = s.r - s.rd * s.rd / (2 * pc.u);
+            r_hi = std::max(r_hi, r_turn);
+            r_lo = std::min(r_lo, r_turn);
+        }
+        if (r_lo < -1e-9) return false;
+        const double rd_max = std::max(std::fabs(s.rd), std::fabs(rd1));
+        RateState e = s;
+        const double dtau = step_rate(e, pc);
+        const bool pure_scale = rd_max == 0 && pc.u == 0 && r_hi <= kPlannedRate;
+        if (!pure_scale && !stretch_safe(tau, tau + dtau, r_hi, rd_max, std::fabs(pc.u), at))
+            return false;
+        s = e;
+        tau += dtau;
+    }
+    return s.rd == 0 && s.r <= kPlannedRate;
+}
+
+// Axis k sees at most: velocity V r, acceleration Acc r^2 + V |r'|, jerk
+// Jrk r^3 + 3 Acc r |r'| + V |r''| (axis_use()). Next to a rough junction the step there
+// (junction share, times r for a velocity step, r^2 for a curvature step) is kept out too.
+bool Sampler::stretch_safe(double from, double to, double r_hi, double rd_max, double rdd_max,
+                           WalkFrom& at) const noexcept {
+    const AxisLimits& lim = cfg_.limits;
+    const double js = cfg_.junction_share;
+    const double r2 = r_hi * r_hi, r3 = r2 * r_hi;
+    auto visit = [&](const PreparedSegment& rec, const ElementBounds& b, const ProfilePhase& ph,
+                     double dur) {
+        const double keep = 1 - cfg_.override_reserve - (rec.rough ? js : 0);
+        const double free_a = 1 - (rec.rough ? js * r_hi : 0);
+        const double free_j = 1 - (rec.rough ? js * r2 : 0);
+        const PhasePeaks pk = phase_peaks(ph, dur);
+        for (int q = 0; q < b.axis_count; ++q) {
+            const int k = b.axes[q];
+            const AxisUse use = axis_use(b, k, pk, std::fabs(ph.j_mm_s3), keep, lim);
+            if (r_hi > kPlannedRate && use.vel * r_hi > lim.vel_mm_s[k]) return false;
+            if (use.acc * r2 + use.vel * rd_max > free_a * lim.acc_mm_s2[k]) return false;
+            if (lim.jerk_mm_s3[k] > 0 && use.jerk * r3 + 3 * r_hi * use.acc * rd_max +
+                                                 use.vel * rdd_max >
+                                             free_j * lim.jerk_mm_s3[k])
+                return false;
+        }
+        return true;
+    };
+    switch (walk_phases(from, to, at, visit)) {
+        case Walk::Covered:
+            return true;
+        case Walk::Stopped:
+            return false;
+        case Walk::Unknown:  // beyond the ring nothing is known: only the fixed bounds hold
+            break;
+    }
+    return r_hi <= kPlannedRate && rd_max <= rl_.max_rate_per_s && rdd_max <= rl_.max_rate_per_s2;
+}
+
+// Without a jerk limit, slowing down from a rate <= 1 (hold, abort, override down): as r falls,
+// a r^2 leaves more of each axis's acceleration to the r' term, and the planned axis speed
+// (bounded over the time it takes to change r') bounds v r' better than vmax does. Both the
+// fixed reserve limits and these stay valid, so the larger of each is used.
 RateLimits Sampler::rate_limits_now(double target, double dt) const noexcept {
-    // Slowing down from a rate <= 1 (hold, abort, override down): as r falls, a r^2 and j r^3
-    // leave more of each axis's limits to the r' and r'' terms, and the planned axis speed
-    // (bounded over the time it takes to change r') bounds v r' better than vmax does. Both
-    // fixed reserve limits and these stay valid, so the larger of each is used.
     if (!(target < r_ && rd_ <= 0 && r_ <= 1)) return rl_;
     const AxisLimits& lim = cfg_.limits;
     const double keep = 1 - cfg_.override_reserve;
     MotionSample now = sample(ring_.peek(0), tau_);
     double horizon = dt + last_limits_.max_rate_per_s / last_limits_.max_rate_per_s2;
-    double vm = kInf, am = kInf;
+    double vm = kInf;
     for (int k = 0; k < kAxes; ++k) {
         double vk = std::fabs(now.vel_mm_s[k]) + lim.acc_mm_s2[k] * r_ * horizon;
         if (vk <= 0) continue;
@@ -271,33 +564,11 @@ RateLimits Sampler::rate_limits_now(double target, double dt) const noexcept {
         const double js = cfg_.junction_share;
         const double used = std::max(keep * r_ * r_, (keep - js) * r_ * r_ + js * r_);
         vm = std::min(vm, lim.acc_mm_s2[k] * (1 - used) / vk);
-        if (lim.jerk_mm_s3[k] > 0) {
-            double free_jerk = lim.jerk_mm_s3[k] * (1 - keep * r_ * r_ * r_);
-            if (r_ > 0) vm = std::min(vm, free_jerk / (2 * 3 * keep * lim.acc_mm_s2[k] * r_));
-            am = std::min(am, free_jerk / (2 * vk));
-        }
     }
     if (!std::isfinite(vm)) return rl_;
-    if (!jerk_limited_) am = vm / kRateRampS;
-    return {std::max(vm, rl_.max_rate_per_s), std::max(am, rl_.max_rate_per_s2)};
+    vm = std::max(vm, rl_.max_rate_per_s);
+    return {vm, vm / kRateRampS};
 }
-
-namespace {
-struct PhasePeaks {
-    double v_mm_s = 0, a_mm_s2 = 0;
-};
-
-// Largest |v| and |a| of one profile phase of duration t_s (v0 + a0 t + j t^2 / 2).
-PhasePeaks phase_peaks(const ProfilePhase& ph, double t_s) noexcept {
-    const double v0 = ph.v0_mm_s, a0 = ph.a0_mm_s2, j = ph.j_mm_s3;
-    double v = std::max(std::fabs(v0), std::fabs(v0 + a0 * t_s + j * t_s * t_s / 2));
-    if (j != 0) {
-        double t_turn = -a0 / j;
-        if (t_turn > 0 && t_turn < t_s) v = std::max(v, std::fabs(v0 - a0 * a0 / (2 * j)));
-    }
-    return {v, std::max(std::fabs(a0), std::fabs(a0 + j * t_s))};
-}
-}  // namespace
 
 // Largest |r'| for which a r^2 + v r' stays within every axis's limit on one profile phase
 // (duration t_s) of a record with derivative bounds b, at rates up to r_hi: axis k sees at most
@@ -484,8 +755,13 @@ void Sampler::consume_finished_records() noexcept {
         }
         if (ring_.peek(1).line != cur.line || is_action(ring_.peek(1))) block_released_ = false;
         action_done_ = false;
-        tau_ -= cur.profile.duration_s;
+        // With a jerk limit the records after a program end start from rest at the start of a
+        // period, where the rate is reset (advance()): the backups checked before never run
+        // past a program end (walk_phases()), so neither may the time left in this period.
+        const bool rest_point = jerk_limited_ && cur.program_end;
+        tau_ = rest_point ? 0.0 : tau_ - cur.profile.duration_s;
         pop_front();
+        if (rest_point) return;
     }
 }
 
@@ -663,6 +939,7 @@ MotionSample Sampler::brake_step(double dt) noexcept {
     status_.done = status_.starved = status_.action_pending = status_.block_paused = false;
     if (stopped) {
         r_ = rd_ = rdd_ = 0;
+        cert_.count = 0;
         if (brake_ == Brake::Fault) {
             status_.aborted = true;
         } else {  // resume the planned profile from the block's end, at rate 0
@@ -730,6 +1007,7 @@ MotionSample Sampler::advance(double dt) noexcept {
     if (ring_.size() == 0) {
         r_ = abort_ || hold_ ? 0 : std::min(override_, 1.0);  // the next record starts at rest
         rd_ = rdd_ = 0;
+        cert_.count = 0;
         status_ = {false, false, false, hold_, abort_, r_, false, false, false};
         if (abort_) status_.aborted = true;
         last_.vel_mm_s = {};
@@ -745,16 +1023,23 @@ MotionSample Sampler::advance(double dt) noexcept {
         return last_;
     }
     double target = rate_target(dt);
-    PathState now = ring_.peek(0).profile.at(tau_);
-    if (now.v_mm_s == 0 && (now.a_mm_s2 == 0 || !jerk_limited_)) {
-        // At rest the rate has nothing to scale yet: take the target at once.
-        r_ = target;
+    const Profile1D& front = ring_.peek(0).profile;
+    PathState now = front.at(tau_);
+    // With a jerk limit, standing at the end of the ring's last record counts as rest too (a
+    // jerk-limited profile ends with rounding errors of speed and acceleration; nothing
+    // moves there, and what comes next starts at a period's start, advance() below).
+    const bool standing = jerk_limited_ && ring_.size() == 1 && tau_ >= front.duration_s;
+    if ((now.v_mm_s == 0 && (now.a_mm_s2 == 0 || !jerk_limited_)) || standing) {
+        // At rest the rate has nothing to scale yet: take the target at once (with a jerk
+        // limit at most 1, where holding it needs no backup; above, it rises from there).
+        r_ = jerk_limited_ ? std::min(target, 1.0) : target;
         rd_ = rdd_ = 0;
+        cert_.count = 0;
     }
-    last_limits_ = rate_limits_now(target, dt);
     if (jerk_limited_) {
-        tau_ += integrate_rate(target, dt, last_limits_);
+        tau_ += advance_rate_jerk(target, dt);
     } else {
+        last_limits_ = rate_limits_now(target, dt);
         last_limits_ = room_limits(last_limits_, target, dt);
         tau_ += integrate_rate_free(target, dt, last_limits_.max_rate_per_s);
     }

@@ -7,8 +7,9 @@
 // largest single period, in ns.
 //
 //   bench_sampler [--benchmark_* options]    the cost table (docs/benchmarks.md)
-//   bench_sampler --digest PROGRAM...        runs each program to its end at 100 %, 120 % and an
-//                                            override toggling between them, jerk unlimited and
+//   bench_sampler --digest PROGRAM...        runs each program to its end at 100 %, 120 %, an
+//                                            override toggling between them and one toggling
+//                                            between 100 % and 30 %, jerk unlimited and
 //                                            1e5 mm/s^3; prints a hash of every sample, so two
 //                                            builds can be shown to sample identically; exits 1
 //                                            if a run leaves the axis limits or does not finish.
@@ -45,9 +46,11 @@ PlannerConfig config_for(double jerk_mm_s3) {
     return cfg;
 }
 
-// The override for period i: fixed, or stepping between 100 % and 120 % every `toggle` periods
-// (long enough for the rate to get there without a jerk limit: 0.2 / 0.1 per s = 2 s).
-enum class OverrideMode { At100, At120, Toggle };
+// The override for period i: fixed, or stepping between 100 % and 120 % (Toggle) or between
+// 100 % and 30 % (Toggle30: slowing down and speeding up below 1, where a jerk-limited rate
+// change checks its room each period) every `toggle` periods (long enough for the rate to get
+// there without a jerk limit: 0.2 / 0.1 per s = 2 s).
+enum class OverrideMode { At100, At120, Toggle, Toggle30 };
 constexpr long kTogglePeriods = 3000;
 
 double override_at(OverrideMode m, long period) {
@@ -58,12 +61,24 @@ double override_at(OverrideMode m, long period) {
             return 1.2;
         case OverrideMode::Toggle:
             return (period / kTogglePeriods) % 2 == 0 ? 1.0 : 1.2;
+        case OverrideMode::Toggle30:
+            return (period / kTogglePeriods) % 2 == 0 ? 1.0 : 0.3;
     }
     return 1.0;
 }
 
 const char* mode_name(OverrideMode m) {
-    return m == OverrideMode::At100 ? "100" : m == OverrideMode::At120 ? "120" : "toggle";
+    switch (m) {
+        case OverrideMode::At100:
+            return "100";
+        case OverrideMode::At120:
+            return "120";
+        case OverrideMode::Toggle:
+            return "toggle";
+        case OverrideMode::Toggle30:
+            return "toggle30";
+    }
+    return "?";
 }
 
 double thread_cpu_ns() {
@@ -116,7 +131,7 @@ void bm_period(benchmark::State& state, const CostCase& c) {
     feeder.top_up(ring);
     Sampler sampler(sampler_config(cfg), ring, prog.start_mm);
     const double overhead_ns = cpu_clock_overhead_ns();
-    std::vector<double> all_ns, rising_ns;
+    std::vector<double> all_ns, rising_ns, changing_ns;
     all_ns.reserve(static_cast<std::size_t>(state.max_iterations));
     long period = 0;
     for (auto _ : state) {
@@ -133,6 +148,7 @@ void bm_period(benchmark::State& state, const CostCase& c) {
         const double ns = std::max(0.0, c1 - c0 - overhead_ns);
         all_ns.push_back(ns);
         if (sampler.status().rate > rate_before) rising_ns.push_back(ns);
+        if (sampler.status().rate != rate_before) changing_ns.push_back(ns);
         ++period;
     }
     auto report = [&](std::vector<double>& v, const std::string& prefix) {
@@ -150,13 +166,18 @@ void bm_period(benchmark::State& state, const CostCase& c) {
         state.counters["rising_periods"] = static_cast<double>(rising_ns.size());
         report(rising_ns, "rise_");
     }
+    if (c.mode == OverrideMode::Toggle30) {  // the periods in which the rate moved
+        state.counters["changing_periods"] = static_cast<double>(changing_ns.size());
+        report(changing_ns, "change_");
+    }
 }
 
 void register_cost_cases() {
     for (const char* program : {"surface_3d.ngc", "tangent_arcs.ngc"})
         for (double jerk : {0.0, kJerkLimited_mm_s3})
             for (OverrideMode mode :
-                 {OverrideMode::At100, OverrideMode::At120, OverrideMode::Toggle}) {
+                 {OverrideMode::At100, OverrideMode::At120, OverrideMode::Toggle,
+                  OverrideMode::Toggle30}) {
                 const std::string name =
                     fmt::format("period/{}/jerk:{:g}/override:{}", program, jerk, mode_name(mode));
                 benchmark::RegisterBenchmark(name.c_str(), bm_period, CostCase{program, jerk, mode})
@@ -186,7 +207,8 @@ bool digest_run(const std::string& path, const bench::BenchProgram& prog, double
     for (const auto& r : recs) ring.try_push(r);
     Sampler sampler(sampler_config(cfg), ring, prog.start_mm);
     Fnv1a hash;
-    double max_v = 0, max_a = 0;
+    double max_v = 0, max_a = 0, max_j = 0;  // max_j: analytic and from the sampled acceleration
+    AxisArray prev_acc{};
     long period = 0;
     constexpr long kMaxPeriods = 10'000'000;
     do {
@@ -201,15 +223,20 @@ bool digest_run(const std::string& path, const bench::BenchProgram& prog, double
         for (int k = 0; k < kAxes; ++k) {
             max_v = std::max(max_v, std::fabs(ms.vel_mm_s[k]));
             max_a = std::max(max_a, std::fabs(ms.acc_mm_s2[k]));
+            const double j_fd = period > 0 ? (ms.acc_mm_s2[k] - prev_acc[k]) / kPeriod_s : 0;
+            max_j = std::max({max_j, std::fabs(ms.jerk_mm_s3[k]), std::fabs(j_fd)});
         }
+        prev_acc = ms.acc_mm_s2;
         ++period;
     } while (!sampler.status().done && period < kMaxPeriods);
     const bool ok = sampler.status().done && max_v <= kVel_mm_s * (1 + 1e-9) &&
-                    max_a <= kAcc_mm_s2 * (1 + 1e-6);
+                    max_a <= kAcc_mm_s2 * (1 + 1e-6) &&
+                    (jerk == 0 || max_j <= jerk * (1 + 1e-6) + 1e-3);
     fmt::print(
-        "{} jerk {:g} override {}: {} periods, max |v| {:.4f}, max |a| {:.3f}, "
+        "{} jerk {:g} override {}: {} periods, max |v| {:.4f}, max |a| {:.3f}{}, "
         "digest {:016x}{}\n",
-        path, jerk, mode_name(mode), period, max_v, max_a, hash.h,
+        path, jerk, mode_name(mode), period, max_v, max_a,
+        jerk > 0 ? fmt::format(", max |j| {:.0f}", max_j) : std::string(), hash.h,
         ok ? "" : "  <-- FAILED (limits or end)");
     return ok;
 }
@@ -220,7 +247,8 @@ int digest_main(int argc, char** argv) {
         const bench::BenchProgram prog = bench::read_program(argv[i], kTolerance_mm);
         for (double jerk : {0.0, kJerkLimited_mm_s3})
             for (OverrideMode mode :
-                 {OverrideMode::At100, OverrideMode::At120, OverrideMode::Toggle})
+                 {OverrideMode::At100, OverrideMode::At120, OverrideMode::Toggle,
+                  OverrideMode::Toggle30})
                 ok = digest_run(argv[i], prog, jerk, mode) && ok;
     }
     return ok ? 0 : 1;

@@ -249,7 +249,7 @@ TEST(Planner, BlendedRightAngleIsTheQuarticWithJerkLimit) {
     EXPECT_NEAR(recs[1].geom.length_mm, 2 * l, 1e-12);
     // Speed through it: the axis curvature bound 1.5 |dT_k| / 2l with |dT_k| = 1 against the
     // blend's centripetal share (0.95) of the usable acceleration.
-    double v = std::sqrt(0.95 * 900 * 2 * l / 1.5);
+    double v = std::sqrt(0.95 * 1000 * (1 - override_reserve_in_effect(cfg)) * 2 * l / 1.5);
     EXPECT_NEAR(recs[1].profile.peak_v_mm_s, v, 1e-9);
     EXPECT_NEAR(right_angle_deviation(recs[1]), tol, 1e-6);
 }

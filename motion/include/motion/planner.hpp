@@ -12,9 +12,10 @@
 //
 // Limit sharing: elements use (1 - reserve) of each axis's acceleration and jerk; the reserve is
 // what the sampler needs to change the time scale (override, hold, abort) without exceeding the
-// limits whatever the plan does. Without a jerk limit the sampler also changes the rate in the
-// room each stretch of the plan leaves (sampler.hpp), so a much smaller fixed reserve is kept
-// then (override_reserve_no_jerk; override_reserve_in_effect() tells which applies). Elements next to a junction that is not smooth (a tiny kink, or a
+// limits whatever the plan does. The sampler also changes the rate in the room each stretch of
+// the plan leaves (sampler.hpp), with and without a jerk limit, so a small fixed reserve is
+// kept (override_reserve, override_reserve_no_jerk: 1 % each; override_reserve_in_effect()
+// tells which applies). Elements next to a junction that is not smooth (a tiny kink, or a
 // curvature step under a jerk limit) also give up `junction_share`: such a junction is passed at
 // a speed where the step is at most junction_share * limit over one servo period.
 //
@@ -36,7 +37,7 @@ namespace motion {
 struct PlannerConfig {
     AxisLimits limits;
     double servo_period_s = 1e-3;
-    double override_reserve = 0.1;  // share of acc/jerk kept for time scaling in the sampler
+    double override_reserve = 0.01;  // share of acc/jerk kept for time scaling in the sampler
     double override_reserve_no_jerk = 0.01;  // the same when no axis has a jerk limit
     double junction_share = 0.1;    // share of acc/jerk a non-smooth junction may take
     double max_rate = 1.2;          // highest feed override the sampler will apply

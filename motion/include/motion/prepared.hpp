@@ -63,6 +63,10 @@ struct PreparedSegment {
     std::uint32_t seq = 0;     // running number, for diagnostics
     bool rapid = false;        // a traverse (G0): the rapid override applies, not the feed override
     bool program_end = false;  // the last record before the planner was told finish(): ends at rest
+    // Next to a junction that is not smooth (planner.hpp): the plan keeps junction_share of the
+    // acceleration and jerk for the step there, which the time scale r multiplies (by r for a
+    // velocity step, r^2 for a curvature step); the sampler keeps that share out of its room.
+    bool rough = false;
     Action action;             // kind != None: a standing record of zero duration (see Action)
     // Digital outputs synchronised with motion (M901; LinuxCNC's M62/M63): bit n set/cleared
     // changes motion.digital-out-n in the period the sampler starts following this record.

@@ -5,18 +5,28 @@
 // planned, 0 = stopped). With planned axis velocity v, acceleration a and jerk j at tau, the
 // commanded motion is
 //     velocity v r,   acceleration a r^2 + v r',   jerk j r^3 + 3 a r r' + v r''.
-// The planner leaves `override_reserve` of each axis's acceleration and jerk unused, and the
-// rate follows its target with |r'| and |r''| small enough that the r', r'' terms fit in that
-// reserve; above r = 1 the per-phase rate caps of the records within reach keep a r^2 and
-// j r^3 within the rest. So any
-// override in [0, max_rate], any hold and any abort keeps every axis within its limits. While
-// slowing down the bounds on r' and r'' grow as a r^2 and j r^3 shrink (rate_limits_now()), so a
-// hold from full speed takes a few tenths of a second rather than 1 / r'max. Without a jerk
-// limit (r'' free, so r' may differ from one period to the next) each period also takes the
-// room the plan itself leaves over the stretch that period covers (room_limits(): the phases'
-// peak speed and acceleration against each axis's limit), in both directions; the planner then
-// keeps only a small fixed reserve (PlannerConfig::override_reserve_no_jerk), and a rate change
-// waits, where the plan uses nearly all of an axis's acceleration, until the plan leaves room.
+// The planner leaves `override_reserve` of each axis's acceleration and jerk unused (1 % by
+// default), and the rate only changes in the room the plan itself leaves:
+// - without a jerk limit (r'' free, so r' may differ from one period to the next) each period
+//   takes the room of the stretch that period covers (room_limits(): the phases' peak speed and
+//   acceleration against each axis's limit), in both directions; while slowing down the bounds
+//   also grow as a r^2 shrinks (rate_limits_now());
+// - with a jerk limit r' must stay continuous, so a rate change that looks fine now must also
+//   be undoable in the room ahead. Each period proposes the time-optimal move towards the target
+//   under bounds taken from the room of the stretch ahead (jerk_room_limits()), and accepts it
+//   only if that move, followed by its backup (r' braked to 0, then r brought down to at most
+//   1, then held; brake_path()), keeps every axis within its velocity, acceleration and jerk
+//   limits over every profile phase it covers (rate_path_safe(): the plan's per-phase peaks
+//   against a r^2 + v r' and j r^3 + 3 a r r' + v r''). Otherwise the period follows the backup
+//   accepted before (cert_), which stays valid because it was checked to its end. A rate held at
+//   r <= 1 is a pure time scale, which the plan keeps within (1 - reserve) of every limit, so
+//   the backup always ends safe; beyond the records in the ring only the fixed bounds
+//   (rate_limits()) are trusted. The rate then changes quickly where the plan leaves room
+//   (cruise, r < 1) and waits, where the plan uses nearly all of an axis's acceleration or
+//   jerk, until it leaves room.
+// Above r = 1 the per-phase rate caps of the records within reach shape the target, and the
+// checks above keep a r^2, j r^3 and v r within the limits. So any override in [0, max_rate],
+// any hold and any abort keeps every axis within its limits.
 //
 // Two stops do not scale time but drive the path speed u directly:
 // - fault_stop() (a drive fault, a limit switch, an e-stop) decelerates along the path at the
@@ -51,7 +61,7 @@ namespace motion {
 
 struct SamplerConfig {
     AxisLimits limits;
-    double override_reserve = 0.1;  // must equal the planner's
+    double override_reserve = 0.01;  // must equal the planner's (override_reserve_in_effect())
     double max_rate = 1.2;          // must equal the planner's
     double junction_share = 0.1;    // must equal the planner's
     // Most records scanned for rate caps per period; also the size of the per-record room cache
@@ -64,8 +74,26 @@ struct RateLimits {
     double max_rate_per_s = 0;   // |r'|
     double max_rate_per_s2 = 0;  // |r''|
 };
-// The largest |r'| and |r''| that fit in the reserve for these limits.
+// The largest |r'| and |r''| that fit in the reserve for these limits whatever the plan does
+// (at r <= 1, or within the planner's rate caps).
 RateLimits rate_limits(const SamplerConfig& cfg) noexcept;
+
+// One piece of a jerk-limited rate move: r'' held at u for h seconds of wall time.
+struct RatePiece {
+    double u = 0;
+    double h = 0;
+    bool zero_rd = false;  // r' lands exactly on 0 at its end (rounding removed)
+    double r_snap = -1;    // >= 0: r lands exactly on this at its end
+};
+// A short sequence of such pieces: a period's move, or the backup that follows it.
+struct RatePath {
+    static constexpr int kMaxPieces = 24;
+    std::array<RatePiece, kMaxPieces> pieces{};
+    int count = 0;
+    void add(const RatePiece& p) noexcept {
+        if (count < kMaxPieces) pieces[static_cast<std::size_t>(count++)] = p;
+    }
+};
 
 struct SamplerStatus {
     bool moving = false;   // rate > 0 and a record is being followed
@@ -129,7 +157,23 @@ class Sampler {
     double rate_cap_free(double dt) noexcept;
     double phase_room(const ElementBounds& b, const ProfilePhase& ph, double t_s,
                       double r_hi) const noexcept;
-    double integrate_rate(double target, double dt, const RateLimits& lim) noexcept;
+    double advance_rate_jerk(double target, double dt) noexcept;
+    RateLimits jerk_room_limits(double target, double dt) const noexcept;
+    bool rate_path_safe(const RatePath& path) const noexcept;
+    struct WalkFrom {
+        std::size_t index = 0;  // first ring record the walk may need
+        double start_s = 0;     // its start in the front record's planned time
+        const PreparedSegment* rec = nullptr;  // the record `bounds` belong to
+        ElementBounds bounds{};
+    };
+    // The phases of the ring's records over planned time [from, to] (front record's time) are
+    // fine with rates up to r_hi, |r'| up to rd_max and |r''| up to rdd_max.
+    bool stretch_safe(double from, double to, double r_hi, double rd_max, double rdd_max,
+                      WalkFrom& at) const noexcept;
+    double apply_rate(const RatePath& path) noexcept;
+    enum class Walk : unsigned char { Covered, Stopped, Unknown };
+    template <class Visit>
+    Walk walk_phases(double from, double to, WalkFrom& at, Visit&& visit) const noexcept;
     double integrate_rate_free(double target, double dt, double max_rate_per_s) noexcept;
     RateLimits rate_limits_now(double target, double dt) const noexcept;
     double room_rate(double from, double to, double r_hi) const noexcept;
@@ -167,6 +211,7 @@ class Sampler {
     SamplerConfig cfg_;
     RateLimits rl_;           // fixed limits from the reserve
     RateLimits last_limits_;  // limits used in the last period
+    RatePath cert_;           // jerk limited: the checked backup from the current (tau, r, r')
     SpscRing<PreparedSegment>& ring_;
     MotionSample last_{};
     double tau_ = 0;  // planned time within the front record
