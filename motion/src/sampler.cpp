@@ -755,13 +755,19 @@ void Sampler::consume_finished_records() noexcept {
         }
         if (ring_.peek(1).line != cur.line || is_action(ring_.peek(1))) block_released_ = false;
         action_done_ = false;
-        // With a jerk limit the records after a program end start from rest at the start of a
-        // period, where the rate is reset (advance()): the backups checked before never run
-        // past a program end (walk_phases()), so neither may the time left in this period.
+        // With a jerk limit the records after a program end start from rest with the rate
+        // reset to a steady r <= 1 (safe at rest, and held it needs no backup): the backups
+        // checked before stop at a program end (walk_phases()), so neither the time left in
+        // this period nor the rate's motion may carry past it.
         const bool rest_point = jerk_limited_ && cur.program_end;
         tau_ = rest_point ? 0.0 : tau_ - cur.profile.duration_s;
         pop_front();
-        if (rest_point) return;
+        if (rest_point) {
+            r_ = std::min(r_, 1.0);
+            rd_ = rdd_ = 0;
+            cert_.count = 0;
+            return;
+        }
     }
 }
 
@@ -1026,9 +1032,10 @@ MotionSample Sampler::advance(double dt) noexcept {
     const Profile1D& front = ring_.peek(0).profile;
     PathState now = front.at(tau_);
     // With a jerk limit, standing at the end of the ring's last record counts as rest too (a
-    // jerk-limited profile ends with rounding errors of speed and acceleration; nothing
-    // moves there, and what comes next starts at a period's start, advance() below).
-    const bool standing = jerk_limited_ && ring_.size() == 1 && tau_ >= front.duration_s;
+    // jerk-limited profile ends with rounding errors of speed and acceleration; nothing moves
+    // there).
+    const bool standing = jerk_limited_ && ring_.size() == 1 && tau_ >= front.duration_s &&
+                          now.v_mm_s * dt < 1e-9;
     if ((now.v_mm_s == 0 && (now.a_mm_s2 == 0 || !jerk_limited_)) || standing) {
         // At rest the rate has nothing to scale yet: take the target at once (with a jerk
         // limit at most 1, where holding it needs no backup; above, it rises from there).

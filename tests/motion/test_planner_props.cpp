@@ -6,6 +6,7 @@
 // aborted ends exactly at its programmed end.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -110,6 +111,10 @@ TEST_P(RandomPrograms, AbortStopsWithinLimitsAndStaysStopped) {
         RateLimits rl = rate_limits(sampler_config(cfg));
         double bound_s =
             cfg.max_rate / rl.max_rate_per_s + 2 * rl.max_rate_per_s / rl.max_rate_per_s2;
+        // With a jerk limit the 1 % fixed bounds alone would take over 10 s; the room the plan
+        // leaves brings it down to 0.1 s on average, 0.41 s at most over 200 seeds (0.70 s and
+        // 1.68 s with the 10 % reserve before).
+        if (seed % 2 == 0) bound_s = std::min(bound_s, 1.0);
         EXPECT_LE((rep.periods - abort_at) * 1e-3, bound_s + 0.01) << "seed " << seed;
     }
 }
