@@ -15,6 +15,20 @@
 
 namespace machine_program {
 
+// Where a machine keeps what the interpreter remembers between runs: the settings file (work
+// offsets, G92, persistent named parameters; [RS274NGC]PARAMETER_FILE) and the tool table
+// (tool lengths and diameters; [EMCIO]TOOL_TABLE). Empty: not kept. While a file does not
+// exist yet its `_seed` is read in its place (the INI's own file, when a settings folder takes
+// the writes); neither existing gives the defaults. machine_state.hpp reads and writes them.
+struct StateFiles {
+    std::string settings;
+    std::string settings_seed;
+    std::string tool_table;
+    std::string tool_table_seed;
+
+    bool operator==(const StateFiles&) const = default;
+};
+
 // What a machine builder chooses about the interpreter. Unset optionals take the dialect's
 // default; the rest default as `cnc canon` does without options.
 struct Options {
@@ -29,6 +43,8 @@ struct Options {
     std::optional<bool> t_changes_tool;  // M06-1: 6th edition yes, V5.4 no (M06 changes)
     bool end_stops_spindle = true;       // M02/M30 stop spindle and coolant
     std::optional<std::int64_t> s_hook_program;  // CUS-4: O-number run after each S block
+    StateFiles state;                            // where the settings are kept
+    interp::Settings settings;                   // as read from `state` with the options
 
     bool operator==(const Options&) const = default;
 };

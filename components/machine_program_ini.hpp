@@ -1,7 +1,9 @@
 // The machine builder's interpreter options (machine_program::Options) from the [RS274NGC]
-// section of the machine's INI. Read by the components that run programs (interp, and motion
-// with program=) from their ini= argument, and by `cnc run` before it loads anything, so a bad
-// value is reported once as `file:line: [RS274NGC]KEY = value: cause`. Configuration world.
+// section of the machine's INI, and the files it keeps the interpreter's state in
+// ([RS274NGC]PARAMETER_FILE, [EMCIO]TOOL_TABLE), read here too. Read by the components that
+// run programs (interp, and motion with program=) from their ini= argument, and by `cnc run`
+// before it loads anything, so a bad value is reported once as `file:line: [RS274NGC]KEY =
+// value: cause` and a bad settings line as `file:line:col: cause`. Configuration world.
 #pragma once
 
 #include <fmt/format.h>
@@ -9,6 +11,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -16,6 +19,7 @@
 #include "hal/ini.hpp"
 #include "hal/types.hpp"
 #include "machine_program.hpp"
+#include "machine_state.hpp"
 
 namespace machine_program {
 
@@ -93,12 +97,54 @@ inline constexpr Key kKeys[] = {
      }},
 };
 
+// `[section]key`, a file relative to the INI's folder (as LinuxCNC resolves it), into `file`;
+// with a settings folder, `file` is the file of that name in the folder and the INI's file
+// only its `seed`.
+inline void place_state_file(const hal::IniFile& ini, const char* section, const char* key,
+                             const std::string& settings_dir, std::string& file,
+                             std::string& seed) {
+    namespace fs = std::filesystem;
+    const Entry* e = ini.find(section, key);
+    if (!e) return;
+    const fs::path given(e->value);
+    if (given.filename().empty()) bad_value(*e, "expected a file name");
+    const fs::path in_config =
+        given.is_absolute() ? given : fs::path(ini.path()).parent_path() / given;
+    if (settings_dir.empty()) {
+        file = in_config.string();
+        return;
+    }
+    file = (fs::path(settings_dir) / given.filename()).string();
+    seed = in_config.string();
+}
+
 }  // namespace ini_detail
 
-// The [RS274NGC] options of `ini`. A key given twice counts once, the first time (as
-// IniFile::get). Throws hal::Error naming the INI line of a bad value.
-inline Options read_ini(const hal::IniFile& ini) {
+// Where the INI keeps the interpreter's state; `settings_dir` non-empty takes the writes (see
+// StateFiles). Throws hal::Error naming the INI line of a bad value.
+inline StateFiles state_files(const hal::IniFile& ini, const std::string& settings_dir = "") {
+    StateFiles f;
+    ini_detail::place_state_file(ini, "RS274NGC", "PARAMETER_FILE", settings_dir, f.settings,
+                                 f.settings_seed);
+    ini_detail::place_state_file(ini, "EMCIO", "TOOL_TABLE", settings_dir, f.tool_table,
+                                 f.tool_table_seed);
+    if (!f.settings.empty() && f.settings == f.tool_table)
+        ini_detail::bad_value(*ini.find("EMCIO", "TOOL_TABLE"),
+                              "the same file as [RS274NGC]PARAMETER_FILE");
+    return f;
+}
+
+// The [RS274NGC] options of `ini`, with the state its files hold (state_files, load_state). A
+// key given twice counts once, the first time (as IniFile::get). Throws hal::Error naming the
+// INI line of a bad value, or the settings file's or tool table's line.
+inline Options read_ini(const hal::IniFile& ini, const std::string& settings_dir = "") {
     Options o;
+    o.state = state_files(ini, settings_dir);
+    try {
+        o.settings = load_state(o.state);
+    } catch (const interp::Error& e) {
+        throw hal::Error(e.what());
+    }
     for (const ini_detail::Key& k : ini_detail::kKeys)
         if (const auto* e = ini.find("RS274NGC", k.name)) k.apply(*e, o);
     if (o.use_default_speed && o.default_feed_mm_min <= 0)
@@ -109,11 +155,17 @@ inline Options read_ini(const hal::IniFile& ini) {
 }
 
 // A component's options from its loadrt arguments: ini= (the machine's INI; its [RS274NGC]
-// section) and dialect= (wins over the INI's DIALECT). Neither given: the defaults.
+// section and state files), dialect= (wins over the INI's DIALECT) and settings_dir= (where
+// the state files are written; see StateFiles). None given: the defaults, nothing kept.
 inline Options options_from_args(const std::optional<std::string>& ini_path,
-                                 const std::optional<std::string>& dialect) {
-    Options o =
-        ini_path && !ini_path->empty() ? read_ini(hal::IniFile::load(*ini_path)) : Options{};
+                                 const std::optional<std::string>& dialect,
+                                 const std::optional<std::string>& settings_dir = std::nullopt) {
+    const bool has_ini = ini_path && !ini_path->empty();
+    const std::string dir = settings_dir.value_or("");
+    if (!dir.empty() && !has_ini)
+        throw hal::Error(fmt::format(
+            "settings_dir={}: needs ini= (the INI names the settings file and tool table)", dir));
+    Options o = has_ini ? read_ini(hal::IniFile::load(*ini_path), dir) : Options{};
     if (dialect && !dialect->empty()) {
         if (!interp::find_dialect(*dialect))
             throw hal::Error(fmt::format("dialect={}: unknown dialect", *dialect));

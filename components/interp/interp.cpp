@@ -3,7 +3,9 @@
 // motion component reads (`loadrt motion canon=interp.canon`). Queue-busting reads
 // (#CURMACHPOS, #CURWORKPOS, G906) wait until motion has followed everything sent and stands
 // in position (motion.canon-sync, wired to interp.motion-sync), then read the machine's
-// position from interp.machine-pos-L. See docs/components/interp.md.
+// position from interp.machine-pos-L. The work offsets, persistent parameters and tool table
+// come from the files the INI names and go back into them as a block changes them
+// (machine_state.hpp). See docs/components/interp.md.
 #include <fmt/format.h>
 
 #include <array>
@@ -130,7 +132,8 @@ class Interp : public hal::Instance, public interpcomp::MachineLink {
             throw hal::Error("program= is required: the G-code file to run");
         if (!std::ifstream(cfg.program_path))
             throw hal::Error(fmt::format("program={}: cannot open the file", cfg.program_path));
-        cfg.options = machine_program::options_from_args(arg("ini"), arg("dialect"));
+        cfg.options =
+            machine_program::options_from_args(arg("ini"), arg("dialect"), arg("settings_dir"));
         cfg.standalone = arg_int("standalone", 0) != 0;
         return cfg;
     }
@@ -171,4 +174,5 @@ class Interp : public hal::Instance, public interpcomp::MachineLink {
 }  // namespace
 
 HAL_COMPONENT(interp, Interp, "G-code interpreter writing canonical commands into a HAL stream",
-              "program", "ini", "dialect", "stream", "depth", "standalone", "num_dio")
+              "program", "ini", "dialect", "settings_dir", "stream", "depth", "standalone",
+              "num_dio")

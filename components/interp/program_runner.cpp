@@ -7,6 +7,7 @@
 #include <utility>
 #include <variant>
 
+#include "../machine_state.hpp"
 #include "interp/canon.hpp"
 #include "interp/dialect.hpp"
 #include "interp/executor.hpp"
@@ -166,7 +167,7 @@ void ProgramRunner::adopt_probe_result(const interp::SourceLoc& loc,
         pos[w->axis] = link_.probe_pos_mm(w->axis);  // the touch, not the stop beyond it
         axes |= 1u << w->axis;
     }
-    executor_->adopt_machine_position(pos, axes);
+    backend_->executor().adopt_machine_position(pos, axes);
     if (!link_.probe_tripped()) throw interp::Error(loc, interp::untripped_message(cm, pos));
 }
 
@@ -197,11 +198,10 @@ void ProgramRunner::finish(const std::string& error) {
 
 void ProgramRunner::open_program() {
     sink_ = std::make_unique<Sink>(*this);
-    executor_ =
-        std::make_unique<interp::Executor>(*sink_, machine_program::backend_config(cfg_.options));
-    machine_ = std::make_unique<LiveMachine>(*this, *executor_);
+    backend_ = std::make_unique<machine_program::MachineExecutor>(*sink_, cfg_.options);
+    machine_ = std::make_unique<LiveMachine>(*this, backend_->executor());
     interpreter_ = std::make_unique<interp::Interpreter>(
-        *executor_, *machine_, machine_program::interpreter_options(cfg_.options));
+        *backend_, *machine_, machine_program::interpreter_options(cfg_.options));
     interpreter_->open(cfg_.program_path);
 }
 

@@ -18,9 +18,12 @@
 #include "interp/canon_wire.hpp"
 
 namespace interp {
-class Executor;
 class Interpreter;
 }  // namespace interp
+
+namespace machine_program {
+class MachineExecutor;
+}  // namespace machine_program
 
 namespace interpcomp {
 
@@ -52,7 +55,8 @@ class MachineLink {
 
 struct RunnerConfig {
     std::string program_path;
-    machine_program::Options options;  // dialect and the machine's [RS274NGC] settings
+    // Dialect, the machine's [RS274NGC] settings, its state files and what they held.
+    machine_program::Options options;
     bool standalone = false;  // no machine: answer reads from the interpreter's own model
 };
 
@@ -115,7 +119,7 @@ class ProgramRunner {
     MachineLink& link_;
     interp::wire::Encoder encoder_;
     std::unique_ptr<Sink> sink_;
-    std::unique_ptr<interp::Executor> executor_;
+    std::unique_ptr<machine_program::MachineExecutor> backend_;  // saves settings changes
     std::unique_ptr<LiveMachine> machine_;
     std::unique_ptr<interp::Interpreter> interpreter_;
     std::deque<interp::wire::Record> outbox_;

@@ -122,7 +122,8 @@ class Motion : public hal::Instance {
                 throw hal::Error("give either program= or canon=, not both");
             canon_.emplace(hal::Stream::attach(this, *canon, interp::wire::kStreamLayout));
         }
-        program_options_ = machine_program::options_from_args(arg("ini"), arg("dialect"));
+        program_options_ =
+            machine_program::options_from_args(arg("ini"), arg("dialect"), arg("settings_dir"));
         const long period_ns = arg_int("servo_period_nsec", 1000000);
         if (period_ns <= 0) throw hal::Error("servo_period_nsec must be > 0");
         servo_period_s_ = static_cast<double>(period_ns) * 1e-9;
@@ -1128,6 +1129,6 @@ class Motion : public hal::Instance {
 }  // namespace
 
 HAL_COMPONENT(motion, Motion, "Trajectory planner and servo-rate motion controller", "num_joints",
-              "coordinates", "kins", "program", "canon", "ini", "dialect", "servo_period_nsec", "queue", "sim_lockstep",
+              "coordinates", "kins", "program", "canon", "ini", "dialect", "settings_dir", "servo_period_nsec", "queue", "sim_lockstep",
               "num_dio", "base_period_nsec", "traj_period_nsec", "num_aio", "num_spindles", "key",
               "base_thread_fp", "unlock_joints_mask")

@@ -10,6 +10,7 @@
 #include <utility>
 #include <variant>
 
+#include "../machine_state.hpp"
 #include "interp/canon.hpp"
 #include "interp/canon_wire.hpp"
 #include "interp/dialect.hpp"
@@ -85,7 +86,7 @@ void ProgramFeeder::take_probe_result() {
         pos[w->axis] = machine_mm[w->axis];
         axes |= 1u << w->axis;
     }
-    executor_->adopt_machine_position(pos, axes);
+    executor_->executor().adopt_machine_position(pos, axes);
     if (!probe_tripped_)
         fail(fmt::format("{}: {}", probe_where_, interp::untripped_message(probe_cmd_, pos)));
 }
@@ -226,10 +227,10 @@ void ProgramFeeder::open_program() {
         decoder_ = std::make_unique<interp::wire::Decoder>();
         return;
     }
-    executor_ = std::make_unique<interp::Executor>(
-        *sink_, machine_program::backend_config(cfg_.program_options));
+    executor_ = std::make_unique<machine_program::MachineExecutor>(*sink_, cfg_.program_options);
     interpreter_ = std::make_unique<interp::Interpreter>(
-        *executor_, *executor_, machine_program::interpreter_options(cfg_.program_options));
+        *executor_, executor_->executor(),
+        machine_program::interpreter_options(cfg_.program_options));
     interpreter_->open(cfg_.program_path);
 }
 

@@ -31,10 +31,13 @@
 #include "plan_sink.hpp"
 
 namespace interp {
-class Executor;
 class Interpreter;
 class CanonSink;
 }  // namespace interp
+
+namespace machine_program {
+class MachineExecutor;
+}  // namespace machine_program
 
 namespace motioncomp {
 
@@ -139,7 +142,7 @@ class ProgramFeeder {
     // Planning state: kept across stop()/start so a paused program continues where it was.
     std::unique_ptr<motion::Planner> planner_;
     std::unique_ptr<PlanSink> sink_;
-    std::unique_ptr<interp::Executor> executor_;
+    std::unique_ptr<machine_program::MachineExecutor> executor_;  // saves settings changes
     std::unique_ptr<interp::Interpreter> interpreter_;
     std::unique_ptr<interp::wire::Decoder> decoder_;  // stream mode
     std::deque<motion::PreparedSegment> outbox_;      // planned, in order, not yet in the ring

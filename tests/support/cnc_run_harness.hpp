@@ -77,12 +77,18 @@ inline std::string sim_ini(const std::string& name, const IniEdit& edit = {}) {
     return text;
 }
 
-// `cnc run ARGS` in `cwd`; stdout and stderr go through files in `scratch`.
+// `cnc run ARGS` in `cwd`; stdout and stderr go through files in `scratch`. Unless ARGS name
+// one, the machine's settings file and tool table are kept in `scratch`/settings
+// (--settings-dir), so a test never writes into configs/ nor sees another test's offsets.
 inline RunResult run_cnc(const std::string& args, const fs::path& scratch,
                          const fs::path& cwd = CNC_SOURCE_DIR) {
     const fs::path out = scratch / "stdout.txt", err = scratch / "stderr.txt";
-    const std::string cmd = fmt::format("cd '{}' && '{}' run {} > '{}' 2> '{}'", cwd.string(),
-                                        CNC_BIN, args, out.string(), err.string());
+    const std::string settings =
+        args.find("--settings-dir") == std::string::npos
+            ? fmt::format(" --settings-dir '{}'", (scratch / "settings").string())
+            : "";
+    const std::string cmd = fmt::format("cd '{}' && '{}' run {}{} > '{}' 2> '{}'", cwd.string(),
+                                        CNC_BIN, args, settings, out.string(), err.string());
     const int status = std::system(cmd.c_str());
     RunResult r;
     r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;

@@ -189,9 +189,9 @@ Config load_config(const RunOptions& o) {
             c.axis_letters += l;
     }
     c.program_lines = count_lines(o.program);
-    // The components read [RS274NGC] again (ini=$(INI_FILE_NAME)); a bad value is reported
-    // here first, as the INI's file:line, before anything is loaded.
-    c.dialect = machine_program::read_ini(ini).dialect;
+    // The components read [RS274NGC] and the state files again (ini=$(INI_FILE_NAME)); a bad
+    // value or settings line is reported here first, as its file:line, before anything loads.
+    c.dialect = machine_program::read_ini(ini, o.settings_dir).dialect;
     if (c.dialect.empty()) c.dialect = "ncstudio";
     return c;
 }
@@ -967,6 +967,11 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& o) {
                     "PNG or SVG picture of the path followed (top, front, side and isometric "
                     "views; feeds and rapids)")
         ->check(CLI::Validator(preview_path_error, "FILE.png|FILE.svg"));
+    cmd->add_option(
+        "--settings-dir", o.settings_dir,
+        "keep the interpreter's settings file and tool table ([RS274NGC]PARAMETER_FILE, "
+        "[EMCIO]TOOL_TABLE) in this folder instead of the INI's; the INI's files are "
+        "read while the folder has none");
     cmd->add_flag("--resume-pauses", o.resume_pauses,
                   "go on at once after M00, M01 or a single-block stop (otherwise Enter on a "
                   "terminal resumes; without a terminal a pause is an error)");
@@ -975,9 +980,24 @@ CLI::App* add_run_command(CLI::App& app, RunOptions& o) {
     return cmd;
 }
 
-int run_program(const RunOptions& o) {
+namespace {
+
+// --settings-dir made absolute (the components may resolve it from another folder) and created.
+std::string prepare_settings_dir(const std::string& dir) {
+    if (dir.empty()) return dir;
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) throw hal::Error(fmt::format("--settings-dir {}: {}", dir, ec.message()));
+    return fs::absolute(dir).string();
+}
+
+}  // namespace
+
+int run_program(const RunOptions& given) {
+    RunOptions o = given;
     Config c;
     try {
+        o.settings_dir = prepare_settings_dir(o.settings_dir);
         c = load_config(o);
     } catch (const hal::Error& e) {
         fmt::print(stderr, "{}\n", e.what());
@@ -988,6 +1008,7 @@ int run_program(const RunOptions& o) {
     ::setenv("CNC_PROGRAM", o.program.c_str(), 1);
     ::setenv("INI_FILE_NAME", fs::absolute(o.ini).c_str(), 1);
     ::setenv("CNC_SIM_LOCKSTEP", o.sim_clock ? "1" : "0", 1);
+    ::setenv("CNC_SETTINGS_DIR", o.settings_dir.c_str(), 1);  // "": the INI's folder
     StopRequest stop;  // before the runtime: its threads inherit the signal mask
     try {
         Session session(o.sim_clock);

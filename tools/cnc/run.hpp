@@ -15,9 +15,10 @@ struct RunOptions {
     std::string program;
     std::string trace_path;    // empty: no trace
     std::string preview_path;  // empty: no picture
+    std::string settings_dir;  // empty: the state files are where the INI says
     bool sim_clock = false;
     bool resume_pauses = false;  // M00/M01/single-block pauses resume at once
-    double timeout_s = 3600;  // motion time (simulated under --sim-clock)
+    double timeout_s = 3600;     // motion time (simulated under --sim-clock)
 };
 
 // Registers the `run` subcommand on `app`, filling `o` when parsed.

@@ -35,4 +35,12 @@ std::string format_settings(const Settings& s);
 // Throws std::runtime_error with the path and errno text on failure; the old file stays intact.
 void save_settings_atomic(const std::string& path, const Settings& s);
 
+// A tool table in LinuxCNC's .tbl form, one line per tool in tool order:
+// "T1 P1 Z40 D6 ;comment" (X and Y only when not 0; a tool without a pocket gets P = its
+// number). What load_linuxcnc_tool_table reads and ignores (A B C U V W I J Q words, comment
+// lines, the order of the lines) is not written back.
+std::string format_linuxcnc_tool_table(const ToolTable& t);
+// Written as save_settings_atomic writes the settings, with the same guarantees and errors.
+void save_tool_table_atomic(const std::string& path, const ToolTable& t);
+
 }  // namespace interp

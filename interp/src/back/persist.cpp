@@ -119,11 +119,11 @@ std::string axes_line(const AxisVec& v) {
 }
 
 // A failed save removes its temporary file, so the old settings file is all that is left.
-[[noreturn]] void abandon_tmp(int fd, const std::string& tmp, const char* what) {
+[[noreturn]] void abandon_tmp(int fd, const std::string& tmp, const char* verb, const char* what) {
     const int err = errno;
     if (fd >= 0) ::close(fd);
     ::unlink(tmp.c_str());
-    sys_fail(what, tmp, err);
+    sys_fail(fmt::format("cannot {} {}", verb, what), tmp, err);
 }
 
 }  // namespace
@@ -176,26 +176,29 @@ std::string format_settings(const Settings& s) {
     return out;
 }
 
-void save_settings_atomic(const std::string& path, const Settings& s) {
-    const std::string text = format_settings(s);
+namespace {
+
+// Temporary file in the same folder, fsync, rename over `path`, fsync the folder: a crash
+// leaves the old file or the new one, never a torn one. `what` names the contents in errors.
+void write_file_atomic(const std::string& path, const std::string& text, const char* what) {
     const std::string tmp = path + ".tmp";
     int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) sys_fail("cannot create temporary settings file", tmp, errno);
+    if (fd < 0) sys_fail(fmt::format("cannot create temporary {} file", what), tmp, errno);
     std::size_t done = 0;
     while (done < text.size()) {
         ssize_t n = ::write(fd, text.data() + done, text.size() - done);
         if (n < 0) {
             if (errno == EINTR) continue;
-            abandon_tmp(fd, tmp, "cannot write settings");
+            abandon_tmp(fd, tmp, "write", what);
         }
         done += static_cast<std::size_t>(n);
     }
-    if (::fsync(fd) != 0) abandon_tmp(fd, tmp, "cannot fsync settings");
-    if (::close(fd) != 0) abandon_tmp(-1, tmp, "cannot write settings");
+    if (::fsync(fd) != 0) abandon_tmp(fd, tmp, "fsync", what);
+    if (::close(fd) != 0) abandon_tmp(-1, tmp, "write", what);
     if (::rename(tmp.c_str(), path.c_str()) != 0) {
         const int err = errno;
         ::unlink(tmp.c_str());
-        sys_fail("cannot replace settings file", path, err);
+        sys_fail(fmt::format("cannot replace {} file", what), path, err);
     }
     // The rename itself must reach the disk, or a crash could bring back the old name.
     const std::filesystem::path parent = std::filesystem::path(path).parent_path();
@@ -205,6 +208,32 @@ void save_settings_atomic(const std::string& path, const Settings& s) {
         ::fsync(dfd);
         ::close(dfd);
     }
+}
+
+}  // namespace
+
+void save_settings_atomic(const std::string& path, const Settings& s) {
+    write_file_atomic(path, format_settings(s), "settings");
+}
+
+std::string format_linuxcnc_tool_table(const ToolTable& t) {
+    std::string out;
+    for (const auto& [n, e] : t.entries()) {
+        // A tool the program created (G923) has no pocket: it gets its own number, as a
+        // LinuxCNC sim table numbers them.
+        out += fmt::format("T{} P{}", n, e.pocket != 0 ? e.pocket : n);
+        // X and Y only when set, as LinuxCNC writes them; a mill's length (Z) always.
+        if (e.offset_mm[0] != 0) out += fmt::format(" X{}", e.offset_mm[0]);
+        if (e.offset_mm[1] != 0) out += fmt::format(" Y{}", e.offset_mm[1]);
+        out += fmt::format(" Z{} D{}", e.offset_mm[2], e.diameter_mm);
+        if (!e.comment.empty()) out += " ;" + e.comment;
+        out += "\n";
+    }
+    return out;
+}
+
+void save_tool_table_atomic(const std::string& path, const ToolTable& t) {
+    write_file_atomic(path, format_linuxcnc_tool_table(t), "tool table");
 }
 
 }  // namespace interp
