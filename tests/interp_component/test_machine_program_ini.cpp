@@ -59,7 +59,7 @@ TEST(MachineProgramIni, EveryKeyReachesTheInterpreter) {
         "T_CHANGES_TOOL = 1\n"
         "END_STOPS_SPINDLE = off\n"
         "S_HOOK_PROGRAM = 9001\n"
-        "PARAMETER_FILE = sim.var\n");  // not ours: left alone
+        "PARAMETER_FILE = sim.var\n");  // no such file here: the default settings
     const interp::BackendConfig b = machine_program::backend_config(o);
     EXPECT_TRUE(b.v54_compat);
     EXPECT_DOUBLE_EQ(b.default_feed_mm_s, 10);  // 600 / 60

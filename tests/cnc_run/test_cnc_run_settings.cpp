@@ -1,0 +1,194 @@
+// `cnc run` keeps the interpreter's state between runs, as LinuxCNC does: work offsets, G92 and
+// persistent parameters in [RS274NGC]PARAMETER_FILE, tool lengths in [EMCIO]TOOL_TABLE. Each
+// test keeps them in its own scratch folder (--settings-dir), so tests run in parallel and
+// never write into configs/sim. Positions are checked by hand from configs/sim/mill.ini
+// (X 0..400, Y 0..300, Z -100..0), configs/sim/sim.tbl (T1 Z40, T2 Z35) and the programs.
+// NcStudio writes work offsets with G922 P<n> (P0 = G54) and tool lengths with G923; ISO's
+// G10 L2 is not implemented by the interpreter.
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "cnc_run_harness.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+using cnc_test::run_cnc;
+using cnc_test::RunResult;
+using cnc_test::ScratchDir;
+using cnc_test::slurp;
+using cnc_test::summary_axes;
+
+const fs::path kSimDir = fs::path(CNC_SOURCE_DIR) / "configs/sim";
+
+// One machine's state folder and the programs run on configs/sim/mill.ini against it.
+class Machine {
+  public:
+    fs::path settings_dir() const { return scratch_.path() / "state"; }
+    fs::path file(const std::string& name) const { return settings_dir() / name; }
+
+    RunResult run(const std::string& name, const std::string& program) const {
+        const fs::path prog = scratch_.path() / name;
+        std::ofstream(prog) << program;
+        return run_cnc(fmt::format("configs/sim/mill.ini '{}' --sim-clock --settings-dir '{}'",
+                                   prog.string(), settings_dir().string()),
+                       scratch_.path());
+    }
+
+    const ScratchDir& scratch() const { return scratch_; }
+
+  private:
+    ScratchDir scratch_;
+};
+
+std::vector<double> final_xyz(const RunResult& r) {
+    return summary_axes(r.out, "final position (mm)");
+}
+
+void expect_xyz(const RunResult& r, double x, double y, double z) {
+    const std::vector<double> p = final_xyz(r);
+    ASSERT_EQ(p.size(), 3u) << r.out << r.err;
+    EXPECT_NEAR(p[0], x, 1e-6);
+    EXPECT_NEAR(p[1], y, 1e-6);
+    EXPECT_NEAR(p[2], z, 1e-6);
+}
+
+TEST(CncRunSettings, WorkOffsetSetInOneRunMovesTheNext) {
+    const Machine m;
+    const RunResult set = m.run("set.ngc", "G90 G21\nG922 P0 X10 Y20 Z-5\nM30\n");
+    ASSERT_EQ(set.exit_code, 0) << set.err << set.out;
+    expect_xyz(set, 0, 0, 0);  // writing an offset moves nothing
+    EXPECT_NE(slurp(m.file("mill.var")).find("\nwcs 1 10 20 -5 0 0 0\n"), std::string::npos)
+        << slurp(m.file("mill.var"));
+    // why: G54's origin is now machine X10 Y20 Z-5, so work X5 Y5 Z0 is machine X15 Y25 Z-5.
+    const RunResult use = m.run("use.ngc", "G90 G21\nG54 G0 X5 Y5 Z0\nM30\n");
+    ASSERT_EQ(use.exit_code, 0) << use.err << use.out;
+    expect_xyz(use, 15, 25, -5);
+}
+
+TEST(CncRunSettings, G92ShiftPersists) {
+    const Machine m;
+    // why: at machine X0 Y0, G92 X-30 Y-40 makes the current point work X-30 Y-40: the shift
+    // is +30 +40, so work X0 Y0 of the next run is machine X30 Y40.
+    ASSERT_EQ(m.run("set.ngc", "G90 G21\nG92 X-30 Y-40\nM30\n").exit_code, 0);
+    const RunResult use = m.run("use.ngc", "G90 G21\nG0 X0 Y0\nM30\n");
+    ASSERT_EQ(use.exit_code, 0) << use.err << use.out;
+    expect_xyz(use, 30, 40, 0);
+}
+
+TEST(CncRunSettings, PersistentParameterWrittenInOneRunIsReadInTheNext) {
+    const Machine m;
+    ASSERT_EQ(m.run("set.ngc", "G90 G21\n#FIXEDCALI_REC = 12.5\nM30\n").exit_code, 0);
+    EXPECT_NE(slurp(m.file("mill.var")).find("\nparam FIXEDCALI_REC 12.5\n"), std::string::npos);
+    const RunResult use = m.run("use.ngc", "G90 G21\nG0 X=#FIXEDCALI_REC\nM30\n");
+    ASSERT_EQ(use.exit_code, 0) << use.err << use.out;
+    expect_xyz(use, 12.5, 0, 0);
+}
+
+TEST(CncRunSettings, ToolLengthComesFromTheTable) {
+    const Machine m;
+    // why: T1 is 40 mm long in sim.tbl; under G43 H1 programmed Z-60 is machine Z-60+40 = -20.
+    const RunResult r = m.run("tool.ngc", "G90 G21\nT1 M6\nG43 H1 G0 Z-60\nM30\n");
+    ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+    expect_xyz(r, 0, 0, -20);
+    // Nothing changed, so nothing was written.
+    EXPECT_FALSE(fs::exists(m.file("sim.tbl")));
+    EXPECT_FALSE(fs::exists(m.file("mill.var")));
+}
+
+TEST(CncRunSettings, ToolLengthWrittenInOneRunIsUsedInTheNextAndTheShippedTableStays) {
+    const std::string shipped = slurp(kSimDir / "sim.tbl");
+    const Machine m;
+    const RunResult set = m.run("set.ngc", "G90 G21\nG923 P1 Z30\nM30\n");
+    ASSERT_EQ(set.exit_code, 0) << set.err << set.out;
+    // The whole table, in tool order, T1 changed and the comments kept.
+    EXPECT_EQ(slurp(m.file("sim.tbl")),
+              "T1 P1 Z30 D6 ;6 mm flat end mill\n"
+              "T2 P2 Z35 D3 ;3 mm flat end mill\n"
+              "T3 P3 Z45 D6 ;6 mm ball end mill\n"
+              "T4 P4 Z50 D10 ;10 mm drill\n");
+    EXPECT_EQ(slurp(kSimDir / "sim.tbl"), shipped);
+    // The settings file holds no tools while a tool table is kept.
+    EXPECT_EQ(slurp(m.file("mill.var")).find("tool "), std::string::npos);
+    // why: Z-60 + 30 = -30.
+    const RunResult use = m.run("use.ngc", "G90 G21\nT1 M6\nG43 H1 G0 Z-60\nM30\n");
+    ASSERT_EQ(use.exit_code, 0) << use.err << use.out;
+    expect_xyz(use, 0, 0, -30);
+}
+
+TEST(CncRunSettings, BadSettingsLineRefusesToStart) {
+    const Machine m;
+    fs::create_directories(m.settings_dir());
+    const std::string bad = "wcs 1 10 20 0 0 0 0\nwcs 2 1 2 three 0 0 0\n";
+    std::ofstream(m.file("mill.var")) << bad;
+    const RunResult r = m.run("use.ngc", "G90 G21\nG0 X5\nM30\n");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_EQ(r.err, fmt::format("{}:2:11: settings: 'three' is not a number\n",
+                                 m.file("mill.var").string()));
+    EXPECT_EQ(r.out, "");  // nothing loaded, nothing moved
+    EXPECT_EQ(slurp(m.file("mill.var")), bad);
+}
+
+TEST(CncRunSettings, BadToolTableLineRefusesToStart) {
+    const Machine m;
+    fs::create_directories(m.settings_dir());
+    std::ofstream(m.file("sim.tbl")) << "T1 P1 Z40 D6\nT2 P2 Zx D3\n";
+    const RunResult r = m.run("use.ngc", "G90 G21\nG0 X5\nM30\n");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_EQ(r.err, fmt::format("{}:2:8: tool table: expected a number after 'Z'\n",
+                                 m.file("sim.tbl").string()));
+}
+
+// A directory where the save's temporary file goes makes the save fail even for root.
+TEST(CncRunSettings, FailedSaveIsAnErrorOfTheBlockAndKeepsTheOldFile) {
+    const Machine m;
+    ASSERT_EQ(m.run("set.ngc", "G90 G21\nG922 P0 X10 Y20\nM30\n").exit_code, 0);
+    const std::string before = slurp(m.file("mill.var"));
+    fs::create_directory(m.file("mill.var.tmp"));
+    const RunResult r = m.run("change.ngc", "G90 G21\nG0 X5\nG922 P0 X1\nG0 X10\nM30\n");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find(fmt::format(
+                  "change.ngc:3:1: settings not saved: {}: cannot create temporary settings "
+                  "file: Is a directory (the file keeps its old contents)",
+                  m.file("mill.var.tmp").string())),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(slurp(m.file("mill.var")), before);
+    // With the obstacle gone the next run starts from the old offsets: work X0 = machine X10.
+    fs::remove(m.file("mill.var.tmp"));
+    const RunResult use = m.run("use.ngc", "G90 G21\nG0 X0 Y0\nM30\n");
+    ASSERT_EQ(use.exit_code, 0) << use.err << use.out;
+    expect_xyz(use, 10, 20, 0);
+}
+
+// Without --settings-dir the files are where the INI says, relative to its folder (LinuxCNC):
+// a config in a scratch folder gets its settings file and tool table written beside it.
+TEST(CncRunSettings, WithoutSettingsDirTheFilesAreBesideTheIni) {
+    const ScratchDir scratch;
+    const fs::path config = scratch.path() / "machine";
+    fs::create_directories(config);
+    std::ofstream(config / "m.ini")
+        << cnc_test::sim_ini("mill", [](const std::string&, std::string& line) {
+               if (line.rfind("PARAMETER_FILE = ", 0) == 0) line = "PARAMETER_FILE = state/m.var";
+               if (line.rfind("TOOL_TABLE = ", 0) == 0) line = "TOOL_TABLE = m.tbl";
+           });
+    fs::create_directories(config / "state");
+    std::ofstream(config / "m.tbl") << "T7 P3 Z12.5 D2 ;engraver\n";
+    const fs::path prog = scratch.path() / "p.ngc";
+    std::ofstream(prog) << "G90 G21\nG922 P1 X7\nG923 P7 Z20\nM30\n";
+    // An empty --settings-dir is no folder: the INI's own paths.
+    const RunResult r = run_cnc(fmt::format("'{}' '{}' --sim-clock --settings-dir ''",
+                                            (config / "m.ini").string(), prog.string()),
+                                scratch.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+    EXPECT_NE(slurp(config / "state/m.var").find("\nwcs 2 7 0 0 0 0 0\n"), std::string::npos);
+    EXPECT_EQ(slurp(config / "m.tbl"), "T7 P3 Z20 D2 ;engraver\n");
+}
+
+}  // namespace
