@@ -91,6 +91,51 @@ std::optional<JointViolation> JointLimitCheck::refine(const motion::Element& e, 
     return refine(e, sm, jm, s1, j1, depth + 1);
 }
 
+bool JointLimitCheck::corners_inside(const motion::AxisArray& from_mm,
+                                     const motion::AxisArray& span_mm, double f) const noexcept {
+    std::array<int, motion::kAxes> moving{};
+    int count = 0;
+    for (int k = 0; k < motion::kAxes; ++k)
+        if (span_mm[k] != 0) moving[count++] = k;
+    Joints j;
+    for (unsigned corner = 1; corner < (1u << count); ++corner) {
+        motion::AxisArray p = from_mm;
+        for (int b = 0; b < count; ++b)
+            if (corner & (1u << b)) p[moving[b]] += f * span_mm[moving[b]];
+        cfg_.kins->kins().inverse(p, std::span<double>(j.data(), joints_));
+        for (std::size_t n = 0; n < joints_; ++n)
+            if (!(j[n] <= cfg_.max_limit[n] + allow_above_[n] + kRounding) ||
+                !(j[n] >= cfg_.min_limit[n] - allow_below_[n] - kRounding))
+                return false;
+    }
+    return true;
+}
+
+double JointLimitCheck::box_scale(const motion::AxisArray& from_mm,
+                                  const motion::AxisArray& span_mm) {
+    if (!cfg_.kins) return 1;
+    Joints j0;
+    cfg_.kins->kins().inverse(from_mm, std::span<double>(j0.data(), joints_));
+    for (std::size_t n = 0; n < joints_; ++n) {
+        allow_above_[n] = std::max(0.0, j0[n] - cfg_.max_limit[n]);
+        allow_below_[n] = std::max(0.0, cfg_.min_limit[n] - j0[n]);
+    }
+    if (corners_inside(from_mm, span_mm, 1)) return 1;
+    // Halved until inside first: a travel up to an axis limit of 1e99 (none set) may be cut
+    // down to millimetres; then bisected to 1e-12 of what is kept.
+    double inside = 0.5, outside = 1;
+    while (!corners_inside(from_mm, span_mm, inside)) {
+        outside = inside;
+        inside *= 0.5;
+        if (inside < 1e-300) return 0;  // the corners at f = 0 are the start itself
+    }
+    while (outside - inside > 1e-12 * inside) {
+        const double f = 0.5 * (inside + outside);
+        (corners_inside(from_mm, span_mm, f) ? inside : outside) = f;
+    }
+    return inside;
+}
+
 // The point of the path where joint v.joint is farthest beyond what the move was allowed (the
 // limit; points before the end also the start's own distance outside): what the message names.
 // Branch and bound with the same curvature allowance as the check (an interval can exceed its

@@ -71,12 +71,21 @@ class JointLimitCheck {
     // joint limit, or none. The start of the path is where the machine stands: it is not
     // refused, only measured (see "A machine standing outside" above).
     std::optional<JointViolation> check(const motion::Element& e);
+    // The largest f in [0, 1] for which every corner of the box from `from_mm` to
+    // from_mm + f * span_mm keeps the joints within their limits (or no farther out than at
+    // `from_mm`): how much of its travel a move whose axes each stop anywhere in their range
+    // (G904) may be given. Exact for a kinematics affine in the axes that
+    // move, as every one here is with its rotary axes still: to 1e-12 of the travel kept.
+    // 1 without a kinematics.
+    double box_scale(const motion::AxisArray& from_mm, const motion::AxisArray& span_mm);
     // The tool length offset the moves from now on run with (G43/G49).
     void set_tool_offset(double tool_offset_mm) noexcept;
     const JointLimitConfig& config() const noexcept { return cfg_; }
 
   private:
     using Joints = std::array<double, kMaxJoints>;
+    bool corners_inside(const motion::AxisArray& from_mm, const motion::AxisArray& span_mm,
+                        double f) const noexcept;
     void joints_at(const motion::Element& e, double s_mm, Joints& out) const noexcept;
     std::optional<JointViolation> beyond(const motion::Element& e, double s_mm, const Joints& j,
                                          bool at_end) const noexcept;

@@ -259,9 +259,24 @@ class Sink final : public PlanSink {
                                                       : here_mm - cfg_.machine.min_limit_mm[axis];
             p.travel_mm = std::max(0.0, std::min(to_limit, w->max_travel_mm.value_or(to_limit)));
         }
+        keep_probe_inside_joint_limits(rec);
         rest(&rec);
         feeder_.await_probe(loc, cm);
     }
+    // Nor past a joint soft limit: each axis may stop anywhere in its travel, so the travels
+    // are shortened together until every corner of the box they span maps inside the joint
+    // limits (a CoreXY probing X and Y at once can reach X + Y at the far corner).
+    void keep_probe_inside_joint_limits(motion::PreparedSegment& rec) {
+        motion::AxisArray span{};
+        for (int k = 0; k < motion::kProbeAxes; ++k) {
+            const motion::ProbeAxis& p = rec.probe[k];
+            if (p.input >= 0 && p.speed_mm_s != 0)
+                span[k] = p.speed_mm_s > 0 ? p.travel_mm : -p.travel_mm;
+        }
+        const double f = joint_check_.box_scale(pos_mm_, span);
+        for (int k = 0; k < motion::kProbeAxes; ++k) rec.probe[k].travel_mm *= f;
+    }
+
     // G916 / G918 / G919 ask the drives to latch their encoders on an input; this machine has
     // no latch path from its drives, so a program that relies on one is refused.
     void handle(const interp::SourceLoc& loc, const interp::canon::LatchConfig&) {
