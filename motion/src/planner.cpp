@@ -51,6 +51,24 @@ constexpr double kIsolatedBlendCentripetal = 0.99;
 // the cut that failed.
 constexpr double kBlendFirstShrink = 0.97;
 constexpr int kBlendBisections = 3;
+// Offset corners (two lines, no jerk limit, offset_corner): the lines are moved up to
+// kOffsetShare of the tolerance outwards (at least kOffsetMinShare of it) so that the parabola
+// between them may cut twice as deep; everything is proved within kOffsetProofShare of the
+// tolerance of the programmed lines. Turns up to about 90 degrees (cos >= kOffsetMinCos).
+// The shifts onto the offset lines and back are cut for kShiftSpeedFactor times the corner's
+// speed on kShiftCentripetal of the acceleration (the rest slows down and speeds up the tool
+// there); measured on the bench programs: 2 x and 3 x, 0.3 to 0.7, gave 2 ms to 60 ms either
+// way, 3 x at 0.5 was best or within 2 ms of best on every program. Where a line has less
+// room a shift is shortened down to kShiftMinSpeedFactor x the corner's speed (2 x: tp_default
+// -5 ms, pocket_sharp -18 ms against no shortening; 1.2 x and 0.8 x: slower again), below
+// that the parabola is used.
+constexpr double kOffsetShare = 0.99;
+constexpr double kOffsetMinShare = 0.1;
+constexpr double kOffsetProofShare = 0.995;
+constexpr double kOffsetMinCos = -0.02;
+constexpr double kShiftSpeedFactor = 3;
+constexpr double kShiftCentripetal = 0.5;
+constexpr double kShiftMinSpeedFactor = 2;
 // With a jerk limit a Bezier blend (curvature steps at its ends) is used only if its ends can
 // be passed at this share of the feed.
 constexpr double kJerkBlendMinFeedShare = 0.25;
@@ -206,10 +224,17 @@ Planner::Junction Planner::classify(const Piece& p, const Piece& next) const {
         // hole sqrt(2) tol short (the miss every turn past 90 degrees is allowed, see above).
         if (cos_angle < kReversalCos) return {0, false, 0};
         // Without a jerk limit the parabola (the per-axis bang-bang corner) is the fastest;
-        // its distance from the lines is (l / 4) sin(angle) (geometry.hpp).
+        // its distance from the lines is (l / 4) sin(angle) (geometry.hpp). When the
+        // tolerance keeps it slower than the moves allow, the corner is cut on offset lines
+        // instead if that fits (offset_corner).
         if (!jerk_mode_) {
-            l = cut_for_speed(std::min(l, p.tolerance_mm / (kParabolaDeviationPerL * sin_angle)),
-                              l_speed_mm);
+            double l_tol = p.tolerance_mm / (kParabolaDeviationPerL * sin_angle);
+            double l_geom = std::min(l, l_tol);
+            if (l_speed_mm > l_tol && l > l_tol) {
+                Junction jn = offset_corner(p, next, sin_angle, l_speed_mm);
+                if (jn.blend == Blend::Offset) return jn;
+            }
+            l = cut_for_speed(l_geom, l_speed_mm);
             if (l > kMinLength_mm) return {kInf, false, l, Blend::Parabola};
         } else {
             l = std::min(l, p.tolerance_mm / (kBlendDeviationPerL * sin_angle));
@@ -350,6 +375,90 @@ Planner::Junction Planner::bezier_corner(const Piece& p, const Piece& next, doub
     return jn;
 }
 
+// The offset corner (no jerk limit; two lines turning by up to about 90 degrees). The parabola
+// alone cuts at most P inside the corner, but the tolerance also allows P outside it. So the
+// tool shifts d <= P outwards off the incoming line (a cubic lane change, shift_out), turns on
+// the parabola between the two lines moved d outwards, which may cut d + P deep, and shifts
+// back onto the outgoing line (shift_back):
+//
+//    line 1 ──────────╮ shift_out
+//    - - - - - - - - -╰──────╮          c2 = the corner of the offset lines, d outside both
+//                  parabola   ╲   ┆
+//                               │ ┆ ← offset line 2
+//                    shift_back ╯
+//                               │ line 2
+//
+// Twice the cut turns sqrt(2) faster (90 degrees at P0.01, 1000 mm/s^2: 12.5 instead of
+// 8.85 mm/s): each axis then passes the corner at sqrt(4 A P), the most the tolerance band
+// allows (docs/benchmarks.md, the acceleration-aware bound). The path is 2 d tan(angle / 2)
+// longer, the shifts need room on both lines, and each piece is proved within the tolerance
+// (bezier_within against the programmed lines); otherwise the caller uses the parabola.
+Planner::Junction Planner::offset_corner(const Piece& p, const Piece& next, double sin_angle,
+                                         double l_speed_mm) const {
+    const Junction none{0, false, 0};
+    const AxisArray &t1 = p.geom.a, &t2 = next.geom.a, &c = p.geom.end;
+    double cos_t = 0;
+    for (int k = 0; k < kAxes; ++k) cos_t += t1[k] * t2[k];
+    if (cos_t < kOffsetMinCos) return none;
+    const double sin_t = std::sqrt(std::max(0.0, 1 - cos_t * cos_t));
+    const double tol = p.tolerance_mm;
+    // The parabola may now lie up to d + kOffsetShare tol from the offset lines; it is cut no
+    // longer than the speed both moves allow needs, and the offset is only as large as that cut
+    // needs (each mm of offset lengthens the path by 2 tan(angle / 2)).
+    const double lp = std::min(2 * kOffsetShare * tol / (kParabolaDeviationPerL * sin_angle),
+                               std::max(l_speed_mm, kSpeedCutFloor * tol));
+    const double d = std::clamp(lp * kParabolaDeviationPerL * sin_angle - kOffsetShare * tol,
+                                kOffsetMinShare * tol, kOffsetShare * tol);
+    const double back = d * (1 - cos_t) / sin_t;  // d tan(angle / 2)
+    if (!(lp > back)) return none;
+    // The parabola's speed (second derivative (t2 - t1) / 2 lp), and the shift length that
+    // lets a shift pass at kShiftSpeedFactor times it on kShiftCentripetal of the acceleration
+    // (a shift's sideways second derivative peaks at 6 d / ls^2). A much shorter shift caps
+    // the speed on the way into the corner and costs more than the corner gains.
+    const AxisLimits& lim = cfg_.limits;
+    AxisArray n1, n2;
+    double turn = kInf, shift = 0;
+    for (int k = 0; k < kAxes; ++k) {
+        n1[k] = -(t2[k] - cos_t * t1[k]) / sin_t;
+        n2[k] = (t1[k] - cos_t * t2[k]) / sin_t;
+        double dt = std::fabs(t2[k] - t1[k]);
+        if (dt > 0) turn = std::min(turn, lim.acc_mm_s2[k] / dt);
+        shift = std::max(shift, std::max(std::fabs(n1[k]), std::fabs(n2[k])) / lim.acc_mm_s2[k]);
+    }
+    const double v_corner_mm_s = std::sqrt(2 * lp * turn);
+    const double ls =
+        kShiftSpeedFactor * v_corner_mm_s * std::sqrt(6 * d * shift / kShiftCentripetal);
+    // Room for the shifts: what the first line has left after the corner at its start (known
+    // by now), half of the second (the corner at its end may take the other half).
+    const double ls1 = std::min(ls, p.geom.length_mm - p.trim_start_mm - (lp - back));
+    const double ls2 = std::min(ls, max_trim_mm(next.geom, 0) - (lp - back));
+    const double keep = kShiftMinSpeedFactor / kShiftSpeedFactor;
+    if (ls1 < keep * ls || ls2 < keep * ls) return none;
+    Junction jn{kInf, false, lp - back + ls1, Blend::Offset};
+    jn.cut_after_mm = lp - back + ls2;
+    // The offset corner c2 is d from both lines, outwards; a0 and b3 lie on the programmed lines.
+    AxisArray c2, a0, a3, b0, b3;
+    for (int k = 0; k < kAxes; ++k) {
+        c2[k] = c[k] + d * (t1[k] - t2[k]) / sin_t;
+        a3[k] = c2[k] - lp * t1[k];
+        a0[k] = a3[k] - ls1 * t1[k] - d * n1[k];
+        b0[k] = c2[k] + lp * t2[k];
+        b3[k] = b0[k] + ls2 * t2[k] - d * n2[k];
+    }
+    std::optional<BezierPoints> out = corner_bezier_points(a0, t1, a3, t1, ls1 / 2);
+    std::optional<BezierPoints> in = corner_bezier_points(b0, t2, b3, t2, ls2 / 2);
+    if (!out || !in) return none;
+    jn.shift_out = *out, jn.shift_back = *in;
+    Element par = make_parabola(c2, t1, t2, lp);
+    jn.corner = {par.origin, par.a, par.b, par.end};
+    const CornerPath path = corner_path(p.geom, jn.blend_l_mm, next.geom, jn.cut_after_mm, tol);
+    const double limit = kOffsetProofShare * tol;
+    if (!bezier_within(jn.shift_out, path, limit) || !bezier_within(jn.corner, path, limit) ||
+        !bezier_within(jn.shift_back, path, limit))
+        return none;
+    return jn;
+}
+
 void Planner::close_piece(Piece& p, Piece* next) {
     Junction jn = next ? classify(p, *next) : Junction{0, false, 0};
     bool rough = p.rough_start || jn.rough;
@@ -370,6 +479,22 @@ void Planner::close_piece(Piece& p, Piece* next) {
     bool isolated = !jerk_mode_ && l > 0 && e.length_mm >= l && next->geom.length_mm / 2 >= 2 * l;
     double turning = isolated ? kIsolatedBlendCentripetal : 0;
     switch (jn.blend) {
+        case Blend::Offset: {
+            Element out =
+                make_bezier(jn.shift_out.p0, jn.shift_out.p1, jn.shift_out.p2, jn.shift_out.p3);
+            // The shift runs along the first move (its line and move; a single block stop
+            // comes at its end, within the tolerance); the turn belongs to the next move, as
+            // every blend does (synchronised outputs switch where it starts).
+            add_item(out, p.feed_mm_s, kInf, false, p, p.rapid, kShiftCentripetal);
+            Element corner = make_bezier(jn.corner.p0, jn.corner.p1, jn.corner.p2, jn.corner.p3);
+            add_item(corner, feed, kInf, false, *next, rapid, kIsolatedBlendCentripetal);
+            Element back =
+                make_bezier(jn.shift_back.p0, jn.shift_back.p1, jn.shift_back.p2, jn.shift_back.p3);
+            add_item(back, next->feed_mm_s, kInf, false, *next, next->rapid, kShiftCentripetal);
+            next->trim_start_mm = jn.cut_after_mm;
+            next->rough_start = false;
+            return;
+        }
         case Blend::Curve:
             add_item(jn.curve, feed, jn.curve_end_cap_mm_s, jn.rough || jn.curve_end_rough, *next,
                      rapid, turning);

@@ -138,29 +138,61 @@ double right_angle_deviation(const PreparedSegment& rec) {
     return worst;
 }
 
-TEST(Planner, BlendedRightAngleIsTheParabolaWithoutJerkLimit) {
+// Without a jerk limit a right angle between long lines is cut on the lines moved d = 0.99 tol
+// outwards (offset_corner): the parabola between them may lie 2 x 0.99 tol from them, so it cuts
+// lp = 4 (2 x 0.99 tol) / sin(90 deg) from each, and its middle is 0.99 tol inside the corner.
+// Shifts of ls = 3 v sqrt(6 d / (0.5 A)) (v = sqrt(2 lp A), the corner's speed at the full
+// acceleration A = 1000) move the tool onto the offset lines and back.
+TEST(Planner, BlendedRightAngleIsCutOnOffsetLinesWithoutJerkLimit) {
     PlannerConfig cfg = uniform(100, 1000, 0);
     const double tol = 0.01;
     auto recs = plan(cfg, {line_to({10}, 50, tol, 0), line_to({10, 10}, 50, tol, 1)});
+    ASSERT_EQ(recs.size(), 5u);
+    for (int i = 1; i <= 3; ++i) ASSERT_EQ(recs[i].geom.kind, ElementKind::Bezier) << i;
+    // The first shift runs along the first move; the turn belongs to the next, as blends do.
+    EXPECT_EQ(recs[1].line, 0);
+    EXPECT_EQ(recs[2].line, 1);
+    EXPECT_EQ(recs[3].line, 1);
+    const double d = 0.99 * tol, lp = 4 * 2 * 0.99 * tol;
+    const double ls = 3 * std::sqrt(2 * lp * 1000) * std::sqrt(6 * d / (0.5 * 1000));
+    // Each line loses lp + ls less d tan(45 deg): the offset corner is d outside both lines.
+    EXPECT_NEAR(recs[0].geom.length_mm, 10 - (lp + ls - d), 1e-12);
+    EXPECT_NEAR(recs[4].geom.length_mm, 10 - (lp + ls - d), 1e-12);
+    EXPECT_NEAR(recs[2].geom.length_mm, 2 * lp, 1e-12);
+    // The corner turns with 0.99 of the usable 990 mm/s^2 (both shifts can change the speed):
+    // sqrt(2) x the 8.855 mm/s of the parabola cut only inside the corner.
+    const double v = std::sqrt(0.99 * 990 * 2 * lp);
+    EXPECT_NEAR(recs[2].profile.peak_v_mm_s, v, 1e-9);
+    EXPECT_NEAR(v, std::sqrt(2.0) * std::sqrt(0.99 * 990 * 0.08) * std::sqrt(0.99), 1e-9);
+    MotionSample mid = sample(recs[2], recs[2].profile.duration_s / 2);
+    EXPECT_NEAR(mid.acc_mm_s2[0], -0.99 * 990, 1e-6);
+    EXPECT_NEAR(mid.acc_mm_s2[1], 0.99 * 990, 1e-6);
+    // 0.99 tol outside along the first shift, 0.99 tol inside at the corner's middle, never
+    // in the quadrant beyond the corner (right_angle_deviation counts that as 1e9).
+    EXPECT_NEAR(right_angle_deviation(recs[1]), d, 1e-6);
+    EXPECT_NEAR(right_angle_deviation(recs[2]), 0.99 * tol, 1e-6);
+    EXPECT_NEAR(right_angle_deviation(recs[3]), d, 1e-6);
+    EXPECT_NEAR(std::hypot(mid.pos_mm[0] - 10 + 0.99 * tol, mid.pos_mm[1] - 0.99 * tol), 0, 1e-9);
+}
+
+// Where the lines leave no room for the shifts the corner is the parabola cut inside it, from
+// l = 4 tol before to l after the corner, with pseudo length 2 l.
+TEST(Planner, BlendedRightAngleBetweenShortLinesIsTheParabolaWithoutJerkLimit) {
+    PlannerConfig cfg = uniform(100, 1000, 0);
+    const double tol = 0.01;
+    auto recs = plan(cfg, {line_to({0.5}, 50, tol, 0), line_to({0.5, 0.5}, 50, tol, 1)});
     ASSERT_EQ(recs.size(), 3u);
     ASSERT_EQ(recs[1].geom.kind, ElementKind::Bezier);
-    // The parabola from l before to l after the corner is (l / 4) sin(90 deg) from the lines at
-    // its middle: l = 4 tol. Its pseudo length is 2 l.
     double l = 4 * tol;
     EXPECT_NEAR(recs[1].geom.length_mm, 2 * l, 1e-12);
-    EXPECT_NEAR(recs[0].geom.length_mm, 10 - l, 1e-12);
-    // Constant acceleration |dT_k| / 2l v^2 per axis against the blend's centripetal share of
-    // the usable acceleration (1000 less the 1 % reserve kept without a jerk limit: 990). Both
-    // lines keep far more than 2l, so they do the speed changes and the blend is isolated: it
-    // turns with 0.99 of it, the bang-bang corner, v = sqrt(0.99 * 990 * 0.08) = 8.855 mm/s.
-    const double usable = 1000 * (1 - override_reserve_in_effect(cfg));
-    EXPECT_NEAR(usable, 990, 1e-9);
-    double v = std::sqrt(0.99 * usable * 2 * l);
+    EXPECT_NEAR(recs[0].geom.length_mm, 0.5 - l, 1e-12);
+    // Constant acceleration |dT_k| / 2l v^2 per axis; the lines keep more than 2l, so the
+    // blend is isolated and turns with 0.99 of the usable 990 mm/s^2: 8.855 mm/s.
+    double v = std::sqrt(0.99 * 990 * 2 * l);
     EXPECT_NEAR(recs[1].profile.peak_v_mm_s, v, 1e-9);
     MotionSample mid = sample(recs[1], recs[1].profile.duration_s / 2);
-    EXPECT_NEAR(mid.acc_mm_s2[0], -0.99 * usable, 1e-6);
-    EXPECT_NEAR(mid.acc_mm_s2[1], 0.99 * usable, 1e-6);
-    EXPECT_NEAR(right_angle_deviation(recs[1]), tol, 1e-6);
+    EXPECT_NEAR(mid.acc_mm_s2[0], -0.99 * 990, 1e-6);
+    EXPECT_NEAR(mid.acc_mm_s2[1], 0.99 * 990, 1e-6);
 }
 
 // In a zigzag of 0.1 mm moves the 90 degree blends (l = 4 tol = 0.04 mm) leave 0.02 mm of each

@@ -103,7 +103,7 @@ class Planner {
         double end_cap_mm_s;
         TangentLimits tangent;
     };
-    enum class Blend : std::uint8_t { None, Quartic, Parabola, Curve };
+    enum class Blend : std::uint8_t { None, Quartic, Parabola, Curve, Offset };
     struct Junction {
         double cap_mm_s;    // speed limit where the first piece ends (at the blend if any)
         bool rough;         // that junction is not smooth
@@ -112,6 +112,10 @@ class Planner {
         Element curve{};                // the Bezier blend, for Blend::Curve
         double curve_end_cap_mm_s = 0;  // speed limit where the Bezier blend ends
         bool curve_end_rough = false;   // that junction is not smooth
+        // Blend::Offset (two lines, no jerk limit): shift out, parabola, shift back; the
+        // first move loses blend_l_mm, the second cut_after_mm.
+        BezierPoints shift_out{}, corner{}, shift_back{};
+        double cut_after_mm = 0;
     };
 
     Junction classify(const Piece& p, const Piece& next) const;
@@ -119,6 +123,10 @@ class Planner {
     // (blend_l_mm = 0) when no blend within the tolerance fits.
     // l_speed_mm: the longest cut worth making (see classify).
     Junction bezier_corner(const Piece& p, const Piece& next, double sin_angle, double feed_mm_s,
+                           double l_speed_mm) const;
+    // The corner of two lines cut on lines moved outwards (see planner.cpp), or none
+    // (blend_l_mm = 0) when that does not fit.
+    Junction offset_corner(const Piece& p, const Piece& next, double sin_angle,
                            double l_speed_mm) const;
     // Highest speed at which a step between these second derivatives stays within the
     // junction share of one period's jerk (infinite without a jerk limit).
