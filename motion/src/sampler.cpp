@@ -398,10 +398,9 @@ double Sampler::apply_rate(const RatePath& path) noexcept {
 // overlaps planned time [from, to] (the front record's time), in order, until visit returns
 // false (Walk::Stopped). Walk::Unknown: the ring (or the look-ahead) ends before `to`. `at`
 // carries where the walk may start between calls with rising `from` (the records wholly
-// before it are skipped for good) and the last record's derivative bounds.
+// before it are skipped for good). The records' bounds come from the cache (cached()).
 template <class Visit>
-Sampler::Walk Sampler::walk_phases(double from, double to, WalkFrom& at,
-                                   Visit&& visit) const noexcept {
+Sampler::Walk Sampler::walk_phases(double from, double to, WalkFrom& at, Visit&& visit) noexcept {
     const std::size_t n = std::min(ring_.size(), cfg_.lookahead_records);
     double start = at.start_s;
     for (std::size_t i = at.index; i < n && start <= to; ++i) {
@@ -411,15 +410,12 @@ Sampler::Walk Sampler::walk_phases(double from, double to, WalkFrom& at,
             at.index = i + 1;
             at.start_s = start + p.duration_s;
         } else if (start + p.duration_s >= from && !is_action(rec)) {
-            if (at.rec != &rec) {
-                at.rec = &rec;
-                at.bounds = bounds(rec.geom);
-            }
+            const ElementBounds& b = cached(i).bounds;
             for (int ph = 0; ph < p.count; ++ph) {
                 const double t0 = p.phases[ph].t0_s;
                 const double t1 = ph + 1 < p.count ? p.phases[ph + 1].t0_s : p.duration_s;
                 if (start + t1 < from || start + t0 > to) continue;
-                if (!visit(rec, at.bounds, p.phases[ph], t1 - t0)) return Walk::Stopped;
+                if (!visit(rec, b, p.phases[ph], t1 - t0)) return Walk::Stopped;
             }
         }
         start += p.duration_s;
@@ -435,7 +431,7 @@ Sampler::Walk Sampler::walk_phases(double from, double to, WalkFrom& at,
 // a r^2 and from half the jerk left beside j r^3 (the 3 a r r' term), r'' from the other half
 // (the v r'' term). Never below the fixed bounds (valid anywhere at r <= 1); only a proposal:
 // rate_path_safe() decides.
-RateLimits Sampler::jerk_room_limits(double target, double dt) const noexcept {
+RateLimits Sampler::jerk_room_limits(double target, double dt) noexcept {
     const double vm0 = last_limits_.max_rate_per_s, am0 = last_limits_.max_rate_per_s2;
     // The highest rate the move and its brake may reach: r' at most vm0 more for that long.
     double reach_s = dt + vm0 / am0;
@@ -481,7 +477,7 @@ RateLimits Sampler::jerk_room_limits(double target, double dt) const noexcept {
 // most their largest values over it (r is quadratic and r' linear in time on a piece). A piece
 // at a steady r <= 1 is a pure time scale of the plan: always fine. The path must end with
 // r' = 0 and r <= 1.
-bool Sampler::rate_path_safe(const RatePath& path) const noexcept {
+bool Sampler::rate_path_safe(const RatePath& path) noexcept {
     RateState s{r_, rd_};
     double tau = tau_;
     WalkFrom at;
@@ -512,7 +508,7 @@ bool Sampler::rate_path_safe(const RatePath& path) const noexcept {
 // Jrk r^3 + 3 Acc r |r'| + V |r''| (axis_use()). Next to a rough junction the step there
 // (junction share, times r for a velocity step, r^2 for a curvature step) is kept out too.
 bool Sampler::stretch_safe(double from, double to, double r_hi, double rd_max, double rdd_max,
-                           WalkFrom& at) const noexcept {
+                           WalkFrom& at) noexcept {
     const AxisLimits& lim = cfg_.limits;
     const double js = cfg_.junction_share;
     const double r2 = r_hi * r_hi, r3 = r2 * r_hi;
@@ -638,7 +634,7 @@ double Sampler::rate_cap_free(double dt) noexcept {
         const PreparedSegment& rec = ring_.peek(i);
         const Profile1D& p = rec.profile;
         if (start + p.duration_s >= tau_ && !is_action(rec)) {
-            const PhaseRooms& rooms = rooms_of(i);
+            const RecordCache& rooms = cached(i);
             for (int ph = 0; ph < p.count; ++ph) {
                 const double t0 = start + p.phases[ph].t0_s;
                 const double t1 = start + (ph + 1 < p.count ? p.phases[ph + 1].t0_s : p.duration_s);
@@ -655,23 +651,24 @@ double Sampler::rate_cap_free(double dt) noexcept {
     return allow;
 }
 
-// The rooms of ring record i (i < lookahead_records), filling the entries up to it first. The
-// phase durations are the record's own (t1 - t0 within the record), so the value does not
+// The cache entry of ring record i (i < lookahead_records), filling the entries up to it first.
+// The phase durations are the record's own (t1 - t0 within the record), so the values do not
 // depend on where the record sits in the queue.
-const Sampler::PhaseRooms& Sampler::rooms_of(std::size_t i) noexcept {
+const Sampler::RecordCache& Sampler::cached(std::size_t i) noexcept {
     const std::size_t size = rooms_.size();
     if (i < rooms_valid_ && rooms_[(rooms_head_ + i) % size].rec != &ring_.peek(i))
         rooms_valid_ = i;  // the ring was popped behind our back: refill from here
     for (; rooms_valid_ <= i; ++rooms_valid_) {
         const std::size_t j = rooms_valid_;
-        PhaseRooms& e = rooms_[(rooms_head_ + j) % size];
+        RecordCache& e = rooms_[(rooms_head_ + j) % size];
         const PreparedSegment& rec = ring_.peek(j);
         e.rec = &rec;
         e.room_per_s.fill(kInf);
         if (is_action(rec)) continue;  // stood on, never scaled
         const Profile1D& p = rec.profile;
-        const ElementBounds b = bounds(rec.geom);
-        for (int ph = 0; ph < p.count; ++ph) {
+        e.bounds = bounds(rec.geom);
+        const ElementBounds& b = e.bounds;
+        for (int ph = 0; ph < p.count && !jerk_limited_; ++ph) {
             const double t0 = p.phases[ph].t0_s;
             const double t1 = ph + 1 < p.count ? p.phases[ph + 1].t0_s : p.duration_s;
             e.room_per_s[ph] = phase_room(b, p.phases[ph], t1 - t0, cfg_.max_rate);
@@ -685,7 +682,7 @@ const Sampler::PhaseRooms& Sampler::rooms_of(std::size_t i) noexcept {
 void Sampler::warm_rooms(std::size_t count) noexcept {
     const std::size_t n = std::min(ring_.size(), rooms_.size());
     const std::size_t upto = std::min(n, rooms_valid_ + count);
-    if (upto > 0 && upto > rooms_valid_) rooms_of(upto - 1);
+    if (upto > 0 && upto > rooms_valid_) cached(upto - 1);
 }
 
 void Sampler::drop_front() noexcept {

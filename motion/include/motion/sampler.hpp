@@ -64,8 +64,9 @@ struct SamplerConfig {
     double override_reserve = 0.01;  // must equal the planner's (override_reserve_in_effect())
     double max_rate = 1.2;          // must equal the planner's
     double junction_share = 0.1;    // must equal the planner's
-    // Most records scanned for rate caps per period; also the size of the per-record room cache
-    // the constructor allocates (jerk unlimited: each record's rooms are computed once).
+    // Most records scanned for rate caps per period; also the size of the per-record cache the
+    // constructor allocates (each record's derivative bounds and, jerk unlimited, its rooms are
+    // computed once).
     std::size_t lookahead_records = 512;
 };
 SamplerConfig sampler_config(const PlannerConfig& p);
@@ -158,22 +159,20 @@ class Sampler {
     double phase_room(const ElementBounds& b, const ProfilePhase& ph, double t_s,
                       double r_hi) const noexcept;
     double advance_rate_jerk(double target, double dt) noexcept;
-    RateLimits jerk_room_limits(double target, double dt) const noexcept;
-    bool rate_path_safe(const RatePath& path) const noexcept;
+    RateLimits jerk_room_limits(double target, double dt) noexcept;
+    bool rate_path_safe(const RatePath& path) noexcept;
     struct WalkFrom {
         std::size_t index = 0;  // first ring record the walk may need
         double start_s = 0;     // its start in the front record's planned time
-        const PreparedSegment* rec = nullptr;  // the record `bounds` belong to
-        ElementBounds bounds{};
     };
     // The phases of the ring's records over planned time [from, to] (front record's time) are
     // fine with rates up to r_hi, |r'| up to rd_max and |r''| up to rdd_max.
     bool stretch_safe(double from, double to, double r_hi, double rd_max, double rdd_max,
-                      WalkFrom& at) const noexcept;
+                      WalkFrom& at) noexcept;
     double apply_rate(const RatePath& path) noexcept;
     enum class Walk : unsigned char { Covered, Stopped, Unknown };
     template <class Visit>
-    Walk walk_phases(double from, double to, WalkFrom& at, Visit&& visit) const noexcept;
+    Walk walk_phases(double from, double to, WalkFrom& at, Visit&& visit) noexcept;
     double integrate_rate_free(double target, double dt, double max_rate_per_s) noexcept;
     RateLimits rate_limits_now(double target, double dt) const noexcept;
     double room_rate(double from, double to, double r_hi) const noexcept;
@@ -184,13 +183,15 @@ class Sampler {
     // discard) does not.
     void pop_front() noexcept;
     void drop_front() noexcept;
-    // phase_room() of each phase of one record at the highest rate (what rate_cap_free() needs),
-    // computed once per record instead of once per period: records never change in the ring.
-    struct PhaseRooms {
+    // What the rate checks need of one record, computed once per record instead of once per
+    // period (records never change in the ring): its derivative bounds and, without a jerk
+    // limit, phase_room() of each phase at the highest rate (what rate_cap_free() needs).
+    struct RecordCache {
         const PreparedSegment* rec = nullptr;  // the ring slot it was computed for (a guard)
+        ElementBounds bounds{};
         std::array<double, kMaxPhases> room_per_s{};
     };
-    const PhaseRooms& rooms_of(std::size_t i) noexcept;
+    const RecordCache& cached(std::size_t i) noexcept;
     void warm_rooms(std::size_t count) noexcept;
     bool pauses_at_block_end(const PreparedSegment& cur) const noexcept;
     enum class Brake : unsigned char { None, Fault, BlockEnd };
@@ -238,7 +239,7 @@ class Sampler {
     SamplerStatus status_{};
     // A ring over the first lookahead_records records: entry i of the ring is at
     // (rooms_head_ + i) % size; the first rooms_valid_ entries are filled.
-    std::vector<PhaseRooms> rooms_;
+    std::vector<RecordCache> rooms_;
     std::size_t rooms_head_ = 0;
     std::size_t rooms_valid_ = 0;
 };
