@@ -43,6 +43,7 @@ struct Options {
     std::optional<bool> t_changes_tool;  // M06-1: 6th edition yes, V5.4 no (M06 changes)
     bool end_stops_spindle = true;       // M02/M30 stop spindle and coolant
     std::optional<std::int64_t> s_hook_program;  // CUS-4: O-number run after each S block
+    std::string library;                         // public.dat ([RS274NGC]LIBRARY); "" = none
     StateFiles state;                            // where the settings are kept
     interp::Settings settings;                   // as read from `state` with the options
 
@@ -59,6 +60,13 @@ inline interp::InterpreterOptions interpreter_options(const Options& o) {
     if (!o.dialect.empty()) options.dialect = interp::find_dialect(o.dialect);
     options.s_hook_program = o.s_hook_program;
     return options;
+}
+
+// Opens `program` as the machine runs it: with the machine's public.dat library, as
+// `cnc canon -l` does. Throws interp::Error "file:line:col: cause".
+inline void open_program(interp::Interpreter& in, const Options& o, const std::string& program) {
+    if (!o.library.empty()) in.load_library(o.library);
+    in.open(program);
 }
 
 // The same derivations from the dialect as `cnc canon --dialect`, so a program runs on the

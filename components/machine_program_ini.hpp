@@ -97,9 +97,15 @@ inline constexpr Key kKeys[] = {
      }},
 };
 
-// `[section]key`, a file relative to the INI's folder (as LinuxCNC resolves it), into `file`;
-// with a settings folder, `file` is the file of that name in the folder and the INI's file
-// only its `seed`.
+// The file an INI entry names, relative to the INI's folder (as LinuxCNC resolves it).
+inline std::filesystem::path config_file(const hal::IniFile& ini, const Entry& e) {
+    const std::filesystem::path given(e.value);
+    if (given.filename().empty()) bad_value(e, "expected a file name");
+    return given.is_absolute() ? given : std::filesystem::path(ini.path()).parent_path() / given;
+}
+
+// `[section]key` (config_file) into `file`; with a settings folder, `file` is the file of that
+// name in the folder and the INI's file only its `seed`.
 inline void place_state_file(const hal::IniFile& ini, const char* section, const char* key,
                              const std::string& settings_dir, std::string& file,
                              std::string& seed) {
@@ -107,9 +113,7 @@ inline void place_state_file(const hal::IniFile& ini, const char* section, const
     const Entry* e = ini.find(section, key);
     if (!e) return;
     const fs::path given(e->value);
-    if (given.filename().empty()) bad_value(*e, "expected a file name");
-    const fs::path in_config =
-        given.is_absolute() ? given : fs::path(ini.path()).parent_path() / given;
+    const fs::path in_config = config_file(ini, *e);
     if (settings_dir.empty()) {
         file = in_config.string();
         return;
@@ -134,7 +138,8 @@ inline StateFiles state_files(const hal::IniFile& ini, const std::string& settin
     return f;
 }
 
-// The [RS274NGC] options of `ini`, with the state its files hold (state_files, load_state). A
+// The [RS274NGC] options of `ini` (LIBRARY: public.dat, relative to the INI's folder), with the
+// state its files hold (state_files, load_state). A
 // key given twice counts once, the first time (as IniFile::get). Throws hal::Error naming the
 // INI line of a bad value, or the settings file's or tool table's line.
 inline Options read_ini(const hal::IniFile& ini, const std::string& settings_dir = "") {
@@ -147,6 +152,13 @@ inline Options read_ini(const hal::IniFile& ini, const std::string& settings_dir
     }
     for (const ini_detail::Key& k : ini_detail::kKeys)
         if (const auto* e = ini.find("RS274NGC", k.name)) k.apply(*e, o);
+    if (const auto* e = ini.find("RS274NGC", "LIBRARY")) {
+        const std::filesystem::path lib = ini_detail::config_file(ini, *e);
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(lib, ec))
+            ini_detail::bad_value(*e, fmt::format("{}: no such file", lib.string()));
+        o.library = lib.string();
+    }
     if (o.use_default_speed && o.default_feed_mm_min <= 0)
         ini_detail::bad_value(
             *ini.find("RS274NGC", "USE_DEFAULT_SPEED"),

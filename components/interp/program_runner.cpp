@@ -202,7 +202,7 @@ void ProgramRunner::open_program() {
     machine_ = std::make_unique<LiveMachine>(*this, backend_->executor());
     interpreter_ = std::make_unique<interp::Interpreter>(
         *backend_, *machine_, machine_program::interpreter_options(cfg_.options));
-    interpreter_->open(cfg_.program_path);
+    machine_program::open_program(*interpreter_, cfg_.options, cfg_.program_path);
 }
 
 void ProgramRunner::run() noexcept {

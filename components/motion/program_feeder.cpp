@@ -231,7 +231,7 @@ void ProgramFeeder::open_program() {
     interpreter_ = std::make_unique<interp::Interpreter>(
         *executor_, executor_->executor(),
         machine_program::interpreter_options(cfg_.program_options));
-    interpreter_->open(cfg_.program_path);
+    machine_program::open_program(*interpreter_, cfg_.program_options, cfg_.program_path);
 }
 
 void ProgramFeeder::run() noexcept {
