@@ -167,6 +167,29 @@ TEST(CncRunSettings, FailedSaveIsAnErrorOfTheBlockAndKeepsTheOldFile) {
     expect_xyz(use, 10, 20, 0);
 }
 
+// An INI without [EMCIO]TOOL_TABLE keeps the tools in the settings file.
+TEST(CncRunSettings, WithoutAToolTableTheToolsAreInTheSettingsFile) {
+    const ScratchDir scratch;
+    const fs::path ini = scratch.path() / "m.ini";
+    std::ofstream(ini) << cnc_test::sim_ini("mill", [](const std::string&, std::string& line) {
+        if (line.rfind("TOOL_TABLE = ", 0) == 0) line = "# no tool table";
+    });
+    const auto run = [&](const std::string& name, const std::string& program) {
+        const fs::path prog = scratch.path() / name;
+        std::ofstream(prog) << program;
+        return run_cnc(fmt::format("'{}' '{}' --sim-clock", ini.string(), prog.string()),
+                       scratch.path());
+    };
+    ASSERT_EQ(run("set.ngc", "G90 G21\nG923 P5 Z22\nM30\n").exit_code, 0);
+    const fs::path settings = scratch.path() / "settings/mill.var";
+    EXPECT_NE(slurp(settings).find("\ntool 5 0 0 22 0\n"), std::string::npos) << slurp(settings);
+    EXPECT_FALSE(fs::exists(scratch.path() / "settings/sim.tbl"));
+    // why: T5 is 22 mm long; Z-60 under G43 H5 is machine Z-38.
+    const RunResult use = run("use.ngc", "G90 G21\nT5 M6\nG43 H5 G0 Z-60\nM30\n");
+    ASSERT_EQ(use.exit_code, 0) << use.err << use.out;
+    expect_xyz(use, 0, 0, -38);
+}
+
 // Without --settings-dir the files are where the INI says, relative to its folder (LinuxCNC):
 // a config in a scratch folder gets its settings file and tool table written beside it.
 TEST(CncRunSettings, WithoutSettingsDirTheFilesAreBesideTheIni) {
