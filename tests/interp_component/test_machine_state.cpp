@@ -1,0 +1,151 @@
+// Where a machine keeps the interpreter's state (components/machine_program_ini.hpp
+// state_files: [RS274NGC]PARAMETER_FILE and [EMCIO]TOOL_TABLE relative to the INI's folder,
+// a settings folder taking the writes) and how it is read and written back
+// (components/machine_state.hpp: load_state, StateSaver). End to end: tests/cnc_run
+// test_cnc_run_settings.cpp and tests/hal/interp-settings-*.
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "hal/ini.hpp"
+#include "hal/types.hpp"
+#include "machine_program_ini.hpp"
+#include "machine_state.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using machine_program::StateFiles;
+
+hal::IniFile ini_of(const std::string& text, const std::string& name = "/cfg/m.ini") {
+    return hal::IniFile::parse(text, name);
+}
+
+std::string error_of(const std::string& text, const std::string& settings_dir = "") {
+    try {
+        machine_program::state_files(ini_of(text, "m.ini"), settings_dir);
+    } catch (const hal::Error& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+std::string read(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+class Folder : public ::testing::Test {
+  protected:
+    void SetUp() override {
+        std::string tmpl = (fs::temp_directory_path() / "machine-state.XXXXXX").string();
+        ASSERT_NE(::mkdtemp(tmpl.data()), nullptr);
+        dir_ = tmpl;
+    }
+    void TearDown() override {
+        std::error_code ec;
+        fs::remove_all(dir_, ec);
+    }
+    fs::path dir_;
+};
+
+TEST(MachineStateFiles, RelativeToTheIniFolderAbsoluteAsGiven) {
+    const StateFiles f = machine_program::state_files(
+        ini_of("[RS274NGC]\nPARAMETER_FILE = sub/m.var\n[EMCIO]\nTOOL_TABLE = /tools/t.tbl\n"));
+    EXPECT_EQ(f.settings, "/cfg/sub/m.var");
+    EXPECT_EQ(f.tool_table, "/tools/t.tbl");
+    EXPECT_EQ(f.settings_seed, "");
+    EXPECT_EQ(f.tool_table_seed, "");
+}
+
+TEST(MachineStateFiles, ASettingsFolderTakesTheFilesByNameAndSeedsFromTheIni) {
+    const StateFiles f = machine_program::state_files(
+        ini_of("[RS274NGC]\nPARAMETER_FILE = sub/m.var\n[EMCIO]\nTOOL_TABLE = /tools/t.tbl\n"),
+        "/state");
+    EXPECT_EQ(f.settings, "/state/m.var");
+    EXPECT_EQ(f.settings_seed, "/cfg/sub/m.var");
+    EXPECT_EQ(f.tool_table, "/state/t.tbl");
+    EXPECT_EQ(f.tool_table_seed, "/tools/t.tbl");
+}
+
+TEST(MachineStateFiles, NoKeysKeepNothing) {
+    EXPECT_EQ(machine_program::state_files(ini_of("[RS274NGC]\nDIALECT = ncstudio\n"), "/state"),
+              StateFiles{});
+}
+
+TEST(MachineStateFiles, BadPathsNameTheIniLine) {
+    EXPECT_EQ(error_of("[RS274NGC]\nPARAMETER_FILE =\n"),
+              "m.ini:2: [RS274NGC]PARAMETER_FILE = : expected a file name");
+    EXPECT_EQ(error_of("[EMCIO]\nTOOL_TABLE = tools/\n"),
+              "m.ini:2: [EMCIO]TOOL_TABLE = tools/: expected a file name");
+    EXPECT_EQ(
+        error_of("[RS274NGC]\nPARAMETER_FILE = a/x.dat\n[EMCIO]\nTOOL_TABLE = b/x.dat\n", "/state"),
+        "m.ini:4: [EMCIO]TOOL_TABLE = b/x.dat: the same file as [RS274NGC]PARAMETER_FILE");
+}
+
+TEST_F(Folder, TheFileWinsOverItsSeedAndMissingFilesGiveTheDefaults) {
+    StateFiles f;
+    f.settings = (dir_ / "state.var").string();
+    f.settings_seed = (dir_ / "seed.var").string();
+    f.tool_table = (dir_ / "state.tbl").string();
+    f.tool_table_seed = (dir_ / "seed.tbl").string();
+    EXPECT_EQ(machine_program::load_state(f), interp::Settings{});
+    std::ofstream(f.settings_seed) << "wcs 1 5 0 0 0 0 0\n";
+    std::ofstream(f.tool_table_seed) << "T1 P1 Z40 D6\n";
+    interp::Settings s = machine_program::load_state(f);
+    EXPECT_EQ(s.offsets.wcs[0][0], 5);
+    ASSERT_NE(s.tools.find(1), nullptr);
+    EXPECT_EQ(s.tools.find(1)->offset_mm[2], 40);
+    std::ofstream(f.settings) << "wcs 1 9 0 0 0 0 0\ntool 1 0 0 11 0\ntool 2 0 0 22 0\n";
+    s = machine_program::load_state(f);
+    EXPECT_EQ(s.offsets.wcs[0][0], 9);
+    EXPECT_EQ(s.tools.find(1)->offset_mm[2], 40);  // the table's tool wins
+    EXPECT_EQ(s.tools.find(2)->offset_mm[2], 22);  // one only the settings file has stays
+}
+
+TEST_F(Folder, AToolTableThatIsAFolderIsAnError) {
+    StateFiles f;
+    f.tool_table = dir_.string();
+    try {
+        machine_program::load_state(f);
+        FAIL() << "no error";
+    } catch (const interp::Error& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  dir_.string() + ":0:0: tool table: cannot read file: Is a directory");
+    }
+}
+
+// Only the file whose part changed is written; with a tool table the settings file has no tools.
+TEST_F(Folder, OnlyWhatChangedIsWritten) {
+    StateFiles f;
+    f.settings = (dir_ / "m.var").string();
+    f.tool_table = (dir_ / "t.tbl").string();
+    interp::Settings s;
+    s.tools.at(1).offset_mm = {0, 0, 40};
+    s.tools.at(1).diameter_mm = 6;
+    machine_program::StateSaver saver(f, s);
+    saver.save(s);
+    EXPECT_FALSE(fs::exists(f.settings));
+    EXPECT_FALSE(fs::exists(f.tool_table));
+    s.tools.at(1).offset_mm[2] = 30;
+    saver.save(s);
+    EXPECT_EQ(read(f.tool_table), "T1 P1 Z30 D6\n");
+    EXPECT_FALSE(fs::exists(f.settings));
+    s.offsets.g92[0] = 2.5;
+    saver.save(s);
+    const std::string var = read(f.settings);
+    EXPECT_NE(var.find("\ng92 2.5 0 0 0 0 0\n"), std::string::npos) << var;
+    EXPECT_EQ(var.find("tool"), std::string::npos) << var;
+    fs::remove(f.tool_table);
+    s.params["FIXEDCALI_REC"] = 1;
+    saver.save(s);  // the tools did not change: the table is not written again
+    EXPECT_FALSE(fs::exists(f.tool_table));
+}
+
+}  // namespace
