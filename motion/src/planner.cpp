@@ -34,7 +34,7 @@ constexpr double kMaxArcTrimShare = 0.45;
 // from the programmed moves' last and first kDeviationReach * l (bezier_within, geometry.hpp),
 // else l shrinks by 0.7, at most kBlendAttempts times.
 constexpr double kDeviationReach = 2;
-constexpr double kDeviationMargin = 0.95;
+constexpr double kDeviationMargin = 0.995;
 constexpr int kBlendAttempts = 12;
 // Without a jerk limit a corner blend is cut for this much more than the speed either move
 // allows at the corner. Between moves of one feed a longer cut costs nothing at the corner, and
