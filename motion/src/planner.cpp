@@ -57,9 +57,9 @@ constexpr int kBlendBisections = 3;
 // tolerance of the programmed lines. Turns up to about 90 degrees (cos >= kOffsetMinCos).
 // The shifts onto the offset lines and back are cut for kShiftSpeedFactor times the corner's
 // speed on kShiftCentripetal of the acceleration (the rest slows down and speeds up the tool
-// there); measured on the bench programs: 2 x and 3 x, 0.3 to 0.7, gave 2 ms to 60 ms either
-// way, 3 x at 0.5 was best or within 2 ms of best on every program. Where a line has less
-// room a shift is shortened down to kShiftMinSpeedFactor x the corner's speed (2 x: tp_default
+// there); measured on the bench programs (2 x to 6 x on 0.2 to 0.7): 3 x at 0.5 is best on
+// pocket_sharp and within 6 ms of the best on the others (docs/benchmarks.md). Where a line has
+// less room a shift is shortened down to kShiftMinSpeedFactor x the corner's speed (2 x: tp_default
 // -5 ms, pocket_sharp -18 ms against no shortening; 1.2 x and 0.8 x: slower again), below
 // that the parabola is used.
 constexpr double kOffsetShare = 0.99;
@@ -379,14 +379,11 @@ Planner::Junction Planner::bezier_corner(const Piece& p, const Piece& next, doub
 // alone cuts at most P inside the corner, but the tolerance also allows P outside it. So the
 // tool shifts d <= P outwards off the incoming line (a cubic lane change, shift_out), turns on
 // the parabola between the two lines moved d outwards, which may cut d + P deep, and shifts
-// back onto the outgoing line (shift_back):
-//
-//    line 1 ──────────╮ shift_out
-//    - - - - - - - - -╰──────╮          c2 = the corner of the offset lines, d outside both
-//                  parabola   ╲   ┆
-//                               │ ┆ ← offset line 2
-//                    shift_back ╯
-//                               │ line 2
+// back onto the outgoing line (shift_back). For a turn from +X onto +Y at the origin: the tool
+// leaves y = 0 for y = -d (shift_out), turns on the parabola from (d - l, -d) to (d, l - d)
+// (control point the offset corner c2 = (d, -d)), whose middle (d - l / 4, l / 4 - d) =
+// (-0.99 P, 0.99 P) for d = 0.99 P, l = 8 x 0.99 P, lies inside the corner, and returns from
+// x = d to x = 0 (shift_back). It never enters the quadrant x > 0, y < 0 beyond the corner.
 //
 // Twice the cut turns sqrt(2) faster (90 degrees at P0.01, 1000 mm/s^2: 12.5 instead of
 // 8.85 mm/s): each axis then passes the corner at sqrt(4 A P), the most the tolerance band
