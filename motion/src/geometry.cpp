@@ -345,15 +345,12 @@ Element trim_line(const Element& line, double from, double to) noexcept {
     return e;
 }
 
-std::optional<BezierPoints> corner_bezier_points(const AxisArray& p0, const AxisArray& t1,
-                                                 const AxisArray& p3, const AxisArray& t2,
-                                                 double l) noexcept {
+namespace {
+
+// The inner control points' distance h along the tangents for corner_bezier_points, from the
+// sums dd = |p3 - p0|^2, ds = (p3 - p0).(t1 + t2), ss = |t1 + t2|^2; 0 if no h fits.
+double corner_bezier_h(double dd, double ds, double ss, double l) {
     const double h0 = 2.0 / 3 * l;
-    double dd = 0, ds = 0, ss = 0;
-    for (int k = 0; k < kAxes; ++k) {
-        double d = p3[k] - p0[k], sk = t1[k] + t2[k];
-        dd += d * d, ds += d * sk, ss += sk * sk;
-    }
     // The hodograph's middle control point is p3 - p0 - h (t1 + t2); its length may not
     // exceed h: f(h) = (ss - 1) h^2 - 2 ds h + dd <= 0.
     auto f = [&](double h) { return (ss - 1) * h * h - 2 * ds * h + dd; };
@@ -372,12 +369,33 @@ std::optional<BezierPoints> corner_bezier_points(const AxisArray& p0, const Axis
             }
         }
     }
-    if (!(h > 0)) return std::nullopt;
-    BezierPoints b{p0, {}, {}, p3};
+    return h > 0 ? h : 0;
+}
+
+void set_corner_bezier(const AxisArray& p0, const AxisArray& t1, const AxisArray& p3,
+                       const AxisArray& t2, double h, BezierPoints& b) {
+    b.p0 = p0;
+    b.p3 = p3;
     for (int k = 0; k < kAxes; ++k) {
         b.p1[k] = p0[k] + h * t1[k];
         b.p2[k] = p3[k] - h * t2[k];
     }
+}
+
+}  // namespace
+
+std::optional<BezierPoints> corner_bezier_points(const AxisArray& p0, const AxisArray& t1,
+                                                 const AxisArray& p3, const AxisArray& t2,
+                                                 double l) noexcept {
+    double dd = 0, ds = 0, ss = 0;
+    for (int k = 0; k < kAxes; ++k) {
+        double d = p3[k] - p0[k], sk = t1[k] + t2[k];
+        dd += d * d, ds += d * sk, ss += sk * sk;
+    }
+    const double h = corner_bezier_h(dd, ds, ss, l);
+    if (!(h > 0)) return std::nullopt;
+    BezierPoints b;
+    set_corner_bezier(p0, t1, p3, t2, h, b);
     return b;
 }
 
@@ -560,6 +578,26 @@ bool prove(const Proof<PathDims>& proof, Hull& piece, int dims) {
     }
 }
 
+template <int PathDims>
+bool prove_hull(const CornerPath& path, double limit_mm, double still_axes2, Hull& piece,
+                int dims) {
+    return prove(Proof<PathDims>{path, limit_mm, still_axes2, dims}, piece, dims);
+}
+
+// bezier_within for a hull in the path's axes (then the blend's own), with still_axes2 the
+// squared distance in the rest.
+bool hull_within(const CornerPath& path, double limit_mm, double still_axes2, Hull& piece,
+                 int dims) {
+    switch (path.dims) {
+        case 2:
+            return prove_hull<2>(path, limit_mm, still_axes2, piece, dims);
+        case 3:
+            return prove_hull<3>(path, limit_mm, still_axes2, piece, dims);
+        default:
+            return prove_hull<0>(path, limit_mm, still_axes2, piece, dims);
+    }
+}
+
 }  // namespace
 
 CornerPath corner_path(const Element& before, double before_mm, const Element& after,
@@ -569,11 +607,25 @@ CornerPath corner_path(const Element& before, double before_mm, const Element& a
     mark_moving_axes(before, path.moving);
     mark_moving_axes(after, path.moving);
     for (int k = 0; k < kAxes; ++k) {
-        if (path.moving[k])
+        if (path.moving[k]) {
             path.axes[path.dims++] = k;
-        else
+        } else {
             path.fixed[k] = before.end[k];
+            path.still_axes[path.still_count++] = k;
+        }
     }
+    // A line's or an arc's points in an axis it does not move are origin + (+-0) terms, its
+    // tangents +-0 (evaluate): equal to fixed and 0 when origin and end are.
+    auto at_rest = [&](const Element& e) {
+        if (e.kind != ElementKind::Line && e.kind != ElementKind::Arc) return false;
+        bool same = true;
+        for (int i = 0; i < path.still_count; ++i) {
+            const int k = path.still_axes[i];
+            same &= (e.origin[k] == path.fixed[k]) & (e.end[k] == path.fixed[k]);
+        }
+        return same;
+    };
+    path.still_at_rest = at_rest(before) && at_rest(after);
     const double len = before.length_mm;
     add_chords(path, before, std::max(0.0, len - before_mm), len, len, before.end, limit_mm);
     add_chords(path, after, 0, std::min(after_mm, after.length_mm), 0, before.end, limit_mm);
@@ -602,14 +654,39 @@ bool bezier_within(const BezierPoints& bezier, const CornerPath& path, double li
             still_axes2 += (x0 - path.fixed[k]) * (x0 - path.fixed[k]);
         }
     }
-    switch (path.dims) {
-        case 2:
-            return prove(Proof<2>{path, limit_mm, still_axes2, dims}, piece, dims);
-        case 3:
-            return prove(Proof<3>{path, limit_mm, still_axes2, dims}, piece, dims);
-        default:
-            return prove(Proof<0>{path, limit_mm, still_axes2, dims}, piece, dims);
+    return hull_within(path, limit_mm, still_axes2, piece, dims);
+}
+
+bool corner_bezier_within(const AxisArray& p0, const AxisArray& t1, const AxisArray& p3,
+                          const AxisArray& t2, double l_mm, const CornerPath& path,
+                          double limit_mm, BezierPoints& out) noexcept {
+    // At rest in the still axes (p0 = p3 = fixed, t1 = t2 = 0 there): d = p3 - p0 and t1 + t2
+    // are +-0, which leave the sums bit for bit as they are; p1 = p0 + h t1 and p2 = p3 - h t2
+    // equal p0 and p3, so bezier_within would count those axes as still, at distance
+    // (p0 - fixed)^2 = 0.
+    if (!path.still_at_rest) {
+        std::optional<BezierPoints> b = corner_bezier_points(p0, t1, p3, t2, l_mm);
+        if (!b || !bezier_within(*b, path, limit_mm)) return false;
+        out = *b;
+        return true;
     }
+    double dd = 0, ds = 0, ss = 0;
+    for (int j = 0; j < path.dims; ++j) {
+        const int k = path.axes[j];
+        double d = p3[k] - p0[k], sk = t1[k] + t2[k];
+        dd += d * d, ds += d * sk, ss += sk * sk;
+    }
+    const double h = corner_bezier_h(dd, ds, ss, l_mm);
+    if (!(h > 0)) return false;
+    Hull piece;
+    for (int j = 0; j < path.dims; ++j) {
+        const int k = path.axes[j];
+        piece[0][j] = p0[k], piece[1][j] = p0[k] + h * t1[k];
+        piece[2][j] = p3[k] - h * t2[k], piece[3][j] = p3[k];
+    }
+    if (!hull_within(path, limit_mm, 0, piece, path.dims)) return false;
+    set_corner_bezier(p0, t1, p3, t2, h, out);
+    return true;
 }
 
 }  // namespace motion

@@ -148,19 +148,20 @@ void Planner::reset(const AxisArray& start) {
 
 void Planner::push(const PathSegment& seg) {
     validate_segment(seg);
-    Piece next{};
-    next.geom =
-        seg.kind == SegmentKind::Arc ? make_arc(last_end_, seg) : make_line(last_end_, seg.end_mm);
+    // Aggregate-initialised: the element is built in place, nothing is cleared first.
+    Piece next{
+        seg.kind == SegmentKind::Arc ? make_arc(last_end_, seg) : make_line(last_end_, seg.end_mm),
+        seg.rapid ? seg.rapid_mm_s : seg.feed_mm_s,
+        seg.rapid,
+        seg.tolerance_mm,
+        seg.exact_stop,
+        seg.line,
+        seg.move_id,
+    };
     if (next.geom.length_mm < kMinLength_mm) {
         if (have_pending_) pending_.exact_stop |= seg.exact_stop;
         return;
     }
-    next.feed_mm_s = seg.rapid ? seg.rapid_mm_s : seg.feed_mm_s;
-    next.rapid = seg.rapid;
-    next.tolerance_mm = seg.tolerance_mm;
-    next.exact_stop = seg.exact_stop;
-    next.line = seg.line;
-    next.move_id = seg.move_id;
     last_end_ = seg.end_mm;
     if (have_pending_) close_piece(pending_, &next);
     pending_ = next;
@@ -332,11 +333,8 @@ Planner::Junction Planner::bezier_corner(const Piece& p, const Piece& next, doub
         const int order = jerk_mode_ ? 2 : 1;  // p'' only for the curvature steps
         evaluate_upto(p.geom, L1 - l_try, order, out.a);
         evaluate_upto(next.geom, l_try, order, out.b);
-        std::optional<BezierPoints> ctrl =
-            corner_bezier_points(out.a.p, out.a.d1, out.b.p, out.b.d1, l_try);
-        if (!ctrl || !bezier_within(*ctrl, path, allowed_mm)) return false;
-        out.ctrl = *ctrl;
-        return true;
+        return corner_bezier_within(out.a.p, out.a.d1, out.b.p, out.b.d1, l_try, path,
+                                    allowed_mm, out.ctrl);
     };
     // Shrink until a cut is proved, first by only 3 % (with an arc the largest provable cut is
     // usually just under the two-line value: 0.974 of it on ex23's 90 degree arc-line corners),
@@ -516,7 +514,6 @@ void Planner::close_piece(Piece& p, Piece* next) {
 void Planner::add_item(const Element& e, double feed, double end_cap, bool rough,
                        const Piece& owner, bool rapid, double blend_centripetal) {
     Item& it = items_.emplace_back(e);
-    it.bounds = bounds(e);
     double cut = reserve_ + (rough ? cfg_.junction_share : 0);
     it.lim = element_limits(e, it.bounds, cfg_.limits, feed, {1 - cut, 1 - cut, blend_centripetal});
     it.end_cap_mm_s = end_cap;

@@ -136,6 +136,11 @@ struct CornerPath {
     int dims = 0;
     std::array<bool, kAxes> moving{};
     AxisArray fixed{};
+    std::array<int, kAxes> still_axes{};  // the others, in increasing order
+    int still_count = 0;
+    // Both moves are lines or arcs that stay at `fixed` in the still axes: every point and
+    // tangent evaluate() gives of them equals fixed there and 0 (see corner_bezier_within).
+    bool still_at_rest = false;
     // Only the first `count` chords are set (left uninitialised: this is built for every
     // corner with an arc, and clearing 2 kB cost as much as the proof).
     std::array<AxisArray, kMaxChords> from, dir;  // chord start, end - start, in `axes`
@@ -152,5 +157,15 @@ CornerPath corner_path(const Element& before, double before_mm, const Element& a
 // within reach of any chord, or after 6 levels of splitting. Exact for axes the path does not
 // move (the blend's values there count as distance). Noexcept, no allocation.
 bool bezier_within(const BezierPoints& bezier, const CornerPath& path, double limit_mm) noexcept;
+
+// corner_bezier_points(p0, t1, p3, t2, l_mm) and, if it gives points, bezier_within(them, path,
+// limit_mm): true and `out` set exactly when both succeed (out is left alone otherwise), for a
+// blend between the path's two moves: p0, t1 must be a point and tangent evaluate() gave of
+// `before`, p3, t2 of `after`. Then, when path.still_at_rest, the axes neither move changes add
+// exact zeros to every sum and distance, so the work is done in the path's axes only and the
+// full points are built only once proved.
+bool corner_bezier_within(const AxisArray& p0, const AxisArray& t1, const AxisArray& p3,
+                          const AxisArray& t2, double l_mm, const CornerPath& path,
+                          double limit_mm, BezierPoints& out) noexcept;
 
 }  // namespace motion

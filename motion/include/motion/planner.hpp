@@ -84,8 +84,8 @@ class Planner {
     };
     struct Item {
         // Built in place in items_ from its element: value-initialising it first would clear
-        // all of it only for add_item() to overwrite it.
-        explicit Item(const Element& e) : geom(e) {}
+        // all of it only for add_item() to overwrite it; bounds() writes straight into it.
+        explicit Item(const Element& e) : geom(e), bounds(motion::bounds(e)) {}
         Element geom;
         ElementBounds bounds;  // bounds(geom), kept for the rate caps when it is emitted
         ElementLimits lim;
