@@ -18,6 +18,18 @@ double norm(const AxisArray& v) {
     return std::sqrt(s);
 }
 
+// Which axes a loop runs over: all nine, or a list.
+struct AllAxes {
+    static constexpr int count() { return kAxes; }
+    constexpr int operator[](int j) const { return j; }
+};
+struct ListedAxes {
+    const int* axes;
+    int n;
+    int count() const { return n; }
+    int operator[](int j) const { return axes[j]; }
+};
+
 // Each evaluator computes the derivatives up to Order (0 = position only, ... 3 = all); the
 // planner asks for positions and tangents far more often than the sampler asks for all of it.
 // Every expression is the same whatever the order, so the values do not depend on it.
@@ -277,8 +289,12 @@ Element make_blend(const AxisArray& corner, const AxisArray& t1, const AxisArray
     return e;
 }
 
-Element make_bezier(const AxisArray& p0, const AxisArray& p1, const AxisArray& p2,
-                    const AxisArray& p3) noexcept {
+namespace {
+
+// make_bezier, its length summed over the listed axes (Axes as for the evaluators).
+template <class Axes>
+Element bezier_in(const AxisArray& p0, const AxisArray& p1, const AxisArray& p2,
+                  const AxisArray& p3, Axes ax) {
     Element e;
     e.kind = ElementKind::Bezier;
     e.origin = p0;
@@ -286,13 +302,28 @@ Element make_bezier(const AxisArray& p0, const AxisArray& p1, const AxisArray& p
     e.b = p2;
     e.end = p3;
     double n0 = 0, n1 = 0, n2 = 0;
-    for (int k = 0; k < kAxes; ++k) {
+    for (int j = 0; j < ax.count(); ++j) {
+        const int k = ax[j];
         n0 += (p1[k] - p0[k]) * (p1[k] - p0[k]);
         n1 += (p2[k] - p1[k]) * (p2[k] - p1[k]);
         n2 += (p3[k] - p2[k]) * (p3[k] - p2[k]);
     }
     e.length_mm = 3 * std::sqrt(std::max({n0, n1, n2}));
     return e;
+}
+
+}  // namespace
+
+Element make_bezier(const AxisArray& p0, const AxisArray& p1, const AxisArray& p2,
+                    const AxisArray& p3) noexcept {
+    return bezier_in(p0, p1, p2, p3, AllAxes{});
+}
+
+Element make_corner_bezier(const BezierPoints& b, const CornerPath& path) noexcept {
+    // The still axes' differences are +-0 (corner_bezier_within), which add nothing.
+    if (path.still_at_rest)
+        return bezier_in(b.p0, b.p1, b.p2, b.p3, ListedAxes{path.axes.data(), path.dims});
+    return make_bezier(b.p0, b.p1, b.p2, b.p3);
 }
 
 Element make_parabola(const AxisArray& corner, const AxisArray& t1, const AxisArray& t2,
@@ -322,16 +353,26 @@ Element trim_arc(const Element& arc, double from, double to, const AxisArray* en
     return e;
 }
 
-EndDerivs start_derivs(const Element& e) noexcept {
+namespace {
+
+EndDerivs derivs_at(const Element& e, double s, bool with_d2) {
     CurvePoint cp;
-    evaluate_to<2>(e, 0, cp);
-    return {cp.d1, cp.d2};
+    if (with_d2) {
+        evaluate_to<2>(e, s, cp);
+        return {cp.d1, cp.d2};
+    }
+    evaluate_to<1>(e, s, cp);
+    return {cp.d1, {}};
 }
 
-EndDerivs end_derivs(const Element& e) noexcept {
-    CurvePoint cp;
-    evaluate_to<2>(e, e.length_mm, cp);
-    return {cp.d1, cp.d2};
+}  // namespace
+
+EndDerivs start_derivs(const Element& e, bool with_d2) noexcept {
+    return derivs_at(e, 0, with_d2);
+}
+
+EndDerivs end_derivs(const Element& e, bool with_d2) noexcept {
+    return derivs_at(e, e.length_mm, with_d2);
 }
 
 Element trim_line(const Element& line, double from, double to) noexcept {
@@ -478,8 +519,8 @@ using Hull = std::array<AxisArray, 4>;
 
 // What bezier_within works with: the path, the limit, the dimensions of the hull points, and
 // the squared distance from the path in the axes neither moves (the same for all points).
-// PathDims is path.dims when known at compile time (the loops unroll), else 0.
-template <int PathDims>
+// PathDims is path.dims and Dims dims when known at compile time (the loops unroll), else 0.
+template <int PathDims, int Dims>
 struct Proof {
     const CornerPath& path;
     double limit_mm;
@@ -503,17 +544,19 @@ struct Proof {
             double x = q[k] - a[k] - t * d[k];
             r += x * x;
         }
-        for (int k = n; k < dims; ++k) r += q[k] * q[k];  // the chord has 0 there
+        const int m = Dims > 0 ? Dims : dims;
+        for (int k = n; k < m; ++k) r += q[k] * q[k];  // the chord has 0 there
         return r;
     }
 
-    // Whether all of the piece's control points lie within reach of chord c.
+    // Whether all of the piece's control points lie within reach of chord c. The end points
+    // first, the last one before all: a piece is tried on its neighbour's chord first, which
+    // holds its start and fails, if at all, at its far end.
     bool hull_near_chord(int c, const Hull& q) const {
         const double r2 = room2(c);
         if (r2 < 0) return false;
-        for (const AxisArray& p : q)
-            if (chord_dist2(c, p) > r2) return false;
-        return true;
+        return chord_dist2(c, q[3]) <= r2 && chord_dist2(c, q[0]) <= r2 &&
+               chord_dist2(c, q[1]) <= r2 && chord_dist2(c, q[2]) <= r2;
     }
 
     // Tries the chord that held the previous piece first: the pieces follow the path in order.
@@ -525,63 +568,71 @@ struct Proof {
         return false;
     }
 
-    // A curve point out of reach of every chord: no piece through it can be proved.
+    // A curve point out of reach of every chord: no piece through it can be proved. The
+    // points tried are the blend's halvings, nearest the corner: its chords first.
     bool beyond_reach(const AxisArray& p) const {
-        for (int c = 0; c < path.count; ++c) {
+        auto near = [&](int c) {
             const double r2 = room2(c);
-            if (r2 >= 0 && chord_dist2(c, p) <= r2) return false;
-        }
+            return r2 >= 0 && chord_dist2(c, p) <= r2;
+        };
+        for (int c = path.corner_chord; c < path.count; ++c)
+            if (near(c)) return false;
+        for (int c = path.corner_chord - 1; c >= 0; --c)
+            if (near(c)) return false;
         return true;
     }
 };
 
-// de Casteljau at u = 1/2.
-void split_half(const Hull& q, Hull& left, Hull& right, int dims) {
-    for (int k = 0; k < dims; ++k) {
+// de Casteljau at u = 1/2: q becomes its left half. Dims as for Proof.
+template <int Dims>
+void split_half(Hull& q, Hull& right, int dims) {
+    const int n = Dims > 0 ? Dims : dims;
+    for (int k = 0; k < n; ++k) {
         double p01 = (q[0][k] + q[1][k]) / 2, p12 = (q[1][k] + q[2][k]) / 2,
                p23 = (q[2][k] + q[3][k]) / 2;
         double p012 = (p01 + p12) / 2, p123 = (p12 + p23) / 2;
         double mid = (p012 + p123) / 2;
-        left[0][k] = q[0][k], left[1][k] = p01, left[2][k] = p012, left[3][k] = mid;
         right[0][k] = mid, right[1][k] = p123, right[2][k] = p23, right[3][k] = q[3][k];
+        q[1][k] = p01, q[2][k] = p012, q[3][k] = mid;
     }
 }
 
 // Only the first `dims` values of each point are ever read.
+template <int Dims>
 void copy_hull(Hull& to, const Hull& from, int dims) {
+    const int n = Dims > 0 ? Dims : dims;
     for (int i = 0; i < 4; ++i)
-        std::copy_n(from[i].begin(), dims, to[i].begin());
+        std::copy_n(from[i].begin(), n, to[i].begin());
 }
 
 // Depth-first over the halvings of `piece` (in `dims` dimensions): `pending` holds the right
 // halves still to be proved.
-template <int PathDims>
-bool prove(const Proof<PathDims>& proof, Hull& piece, int dims) {
+template <int PathDims, int Dims>
+bool prove(const Proof<PathDims, Dims>& proof, Hull& piece, int dims) {
     std::array<Hull, kMaxSplitDepth + 1> pending;
     std::array<int, kMaxSplitDepth + 1> pending_depth;
-    int top = 0, depth = 0, hint = 0;
+    // The first piece proved is the blend's start, on the move before the corner near it.
+    int top = 0, depth = 0, hint = proof.path.corner_chord;
     for (;;) {
         // The whole blend spans both moves: start with its halves.
         if (depth > 0 && proof.hull_near_path(piece, hint)) {
             if (top == 0) return true;
             --top;
-            copy_hull(piece, pending[top], dims);
+            copy_hull<Dims>(piece, pending[top], dims);
             depth = pending_depth[top];
             continue;
         }
         if (depth == kMaxSplitDepth) return false;
-        Hull left;
-        split_half(piece, left, pending[top], dims);
-        if (proof.beyond_reach(left[3])) return false;
+        split_half<Dims>(piece, pending[top], dims);
+        if (proof.beyond_reach(piece[3])) return false;
         pending_depth[top++] = ++depth;
-        copy_hull(piece, left, dims);
     }
 }
 
-template <int PathDims>
+template <int PathDims, int Dims = 0>
 bool prove_hull(const CornerPath& path, double limit_mm, double still_axes2, Hull& piece,
                 int dims) {
-    return prove(Proof<PathDims>{path, limit_mm, still_axes2, dims}, piece, dims);
+    return prove(Proof<PathDims, Dims>{path, limit_mm, still_axes2, dims}, piece, dims);
 }
 
 // bezier_within for a hull in the path's axes (then the blend's own), with still_axes2 the
@@ -590,9 +641,11 @@ bool hull_within(const CornerPath& path, double limit_mm, double still_axes2, Hu
                  int dims) {
     switch (path.dims) {
         case 2:
-            return prove_hull<2>(path, limit_mm, still_axes2, piece, dims);
+            return dims == 2 ? prove_hull<2, 2>(path, limit_mm, still_axes2, piece, dims)
+                             : prove_hull<2>(path, limit_mm, still_axes2, piece, dims);
         case 3:
-            return prove_hull<3>(path, limit_mm, still_axes2, piece, dims);
+            return dims == 3 ? prove_hull<3, 3>(path, limit_mm, still_axes2, piece, dims)
+                             : prove_hull<3>(path, limit_mm, still_axes2, piece, dims);
         default:
             return prove_hull<0>(path, limit_mm, still_axes2, piece, dims);
     }
@@ -628,6 +681,7 @@ CornerPath corner_path(const Element& before, double before_mm, const Element& a
     path.still_at_rest = at_rest(before) && at_rest(after);
     const double len = before.length_mm;
     add_chords(path, before, std::max(0.0, len - before_mm), len, len, before.end, limit_mm);
+    path.corner_chord = path.count - 1;
     add_chords(path, after, 0, std::min(after_mm, after.length_mm), 0, before.end, limit_mm);
     return path;
 }

@@ -157,6 +157,8 @@ void Planner::push(const PathSegment& seg) {
         seg.exact_stop,
         seg.line,
         seg.move_id,
+        0,
+        false,
     };
     if (next.geom.length_mm < kMinLength_mm) {
         if (have_pending_) pending_.exact_stop |= seg.exact_stop;
@@ -178,8 +180,9 @@ void Planner::finish() {
 
 Planner::Junction Planner::classify(const Piece& p, const Piece& next) const {
     if (p.exact_stop) return {0, false, 0};
-    EndDerivs pe = end_derivs(p.geom);
-    EndDerivs ns = start_derivs(next.geom);
+    // p'' only for the curvature steps, which cost nothing without a jerk limit.
+    EndDerivs pe = end_derivs(p.geom, jerk_mode_);
+    EndDerivs ns = start_derivs(next.geom, jerk_mode_);
     AxisArray dt;
     double dmax = 0, dnorm2 = 0;
     for (int k = 0; k < kAxes; ++k) {
@@ -358,7 +361,7 @@ Planner::Junction Planner::bezier_corner(const Piece& p, const Piece& next, doub
     }
     const CurvePoint &a = fit.a, &b = fit.b;
     Junction jn{kInf, false, l, Blend::Curve};
-    jn.curve = make_bezier(fit.ctrl.p0, fit.ctrl.p1, fit.ctrl.p2, fit.ctrl.p3);
+    jn.curve = make_corner_bezier(fit.ctrl, path);
     jn.curve_end_cap_mm_s = kInf;
     if (!jerk_mode_) return jn;  // without a jerk limit curvature steps cost nothing
     EndDerivs bs = start_derivs(jn.curve), be = end_derivs(jn.curve);

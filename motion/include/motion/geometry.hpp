@@ -86,8 +86,9 @@ Element make_blend(const AxisArray& corner, const AxisArray& t1, const AxisArray
 struct EndDerivs {
     AxisArray tangent{}, d2{};
 };
-EndDerivs start_derivs(const Element& e) noexcept;
-EndDerivs end_derivs(const Element& e) noexcept;
+// with_d2 false: d2 is left 0 (not needed, not computed).
+EndDerivs start_derivs(const Element& e, bool with_d2 = true) noexcept;
+EndDerivs end_derivs(const Element& e, bool with_d2 = true) noexcept;
 
 // Cubic Bezier blend through control points p0..p3 (see above). Its pseudo length is positive
 // unless all four points coincide.
@@ -146,6 +147,7 @@ struct CornerPath {
     std::array<AxisArray, kMaxChords> from, dir;  // chord start, end - start, in `axes`
     std::array<double, kMaxChords> inv_len2, slack_mm;
     int count = 0;
+    int corner_chord = 0;  // the last chord of `before`, ending at the corner
 };
 CornerPath corner_path(const Element& before, double before_mm, const Element& after,
                        double after_mm, double limit_mm) noexcept;
@@ -167,5 +169,10 @@ bool bezier_within(const BezierPoints& bezier, const CornerPath& path, double li
 bool corner_bezier_within(const AxisArray& p0, const AxisArray& t1, const AxisArray& p3,
                           const AxisArray& t2, double l_mm, const CornerPath& path,
                           double limit_mm, BezierPoints& out) noexcept;
+
+// make_bezier(b.p0, b.p1, b.p2, b.p3) for points corner_bezier_within() gave for this path: when
+// path.still_at_rest they do not differ in the still axes, so the length's sums run over the
+// path's axes only.
+Element make_corner_bezier(const BezierPoints& b, const CornerPath& path) noexcept;
 
 }  // namespace motion
