@@ -660,9 +660,9 @@ double time_at(const Profile1D& p, double s) {
     return ph.t0_s + (b.lo + b.hi) / 2;
 }
 
-// The part of p between times ta and tb, shifted to start at time 0 and position 0.
-Profile1D clip(const Profile1D& p, double ta, double tb, double sa) {
-    Profile1D out;
+// The part of p between times ta and tb, shifted to start at time 0 and position 0, into out
+// (a default Profile1D).
+void clip_into(Profile1D& out, const Profile1D& p, double ta, double tb, double sa) {
     for (int i = 0; i < p.count; ++i) {
         const ProfilePhase& ph = p.phases[i];
         double end = i + 1 < p.count ? p.phases[i + 1].t0_s : p.duration_s;
@@ -678,17 +678,18 @@ Profile1D clip(const Profile1D& p, double ta, double tb, double sa) {
         q.j_mm_s3 = ph.j_mm_s3;
     }
     out.duration_s = tb - ta;
-    return out;
 }
 
 }  // namespace
 
 void Planner::emit_group(const Group& g, double v_in, double v_out) {
-    Profile1D prof = build_profile(g.length_mm, v_in, v_out, g.vcap_mm_s, g.tangent);
     if (g.end - g.first == 1) {
-        emit(items_[g.first], prof);
+        emit(items_[g.first], [&](Profile1D& out) {
+            build_profile_into(out, g.length_mm, v_in, v_out, g.vcap_mm_s, g.tangent);
+        });
         return;
     }
+    const Profile1D prof = build_profile(g.length_mm, v_in, v_out, g.vcap_mm_s, g.tangent);
     // One profile over the whole group, cut at the element boundaries: the acceleration runs on
     // across them instead of returning to zero at each.
     double s = 0, t = 0;
@@ -696,20 +697,22 @@ void Planner::emit_group(const Group& g, double v_in, double v_out) {
         const Item& it = items_[i];
         double s_end = s + it.geom.length_mm;
         double t_end = i + 1 == g.end ? prof.duration_s : time_at(prof, s_end);
-        emit(it, clip(prof, t, t_end, s));
+        emit(it, [&](Profile1D& out) { clip_into(out, prof, t, t_end, s); });
         s = s_end;
         t = t_end;
     }
 }
 
-void Planner::emit(const Item& it, const Profile1D& prof) {
+template <class MakeProfile>
+void Planner::emit(const Item& it, MakeProfile&& make_profile) {
     if (out_head_ == out_.size()) {
         out_.clear();
         out_head_ = 0;
     }
     PreparedSegment& rec = out_.emplace_back();
     rec.geom = it.geom;
-    rec.profile = prof;
+    make_profile(rec.profile);  // written in place: a 320-byte copy less per record
+    const Profile1D& prof = rec.profile;
     LimitShares rate_share{1 - reserve_, 1 - reserve_};
     const ElementBounds& b = it.bounds;
     for (int i = 0; i < prof.count; ++i) {

@@ -140,6 +140,12 @@ double reachable_speed_mm_s(double v0, double length, const TangentLimits& lim) 
 Profile1D build_profile(double length, double v_in, double v_out, double vcap,
                         const TangentLimits& lim) noexcept {
     Profile1D prof;
+    build_profile_into(prof, length, v_in, v_out, vcap, lim);
+    return prof;
+}
+
+void build_profile_into(Profile1D& prof, double length, double v_in, double v_out, double vcap,
+                        const TangentLimits& lim) noexcept {
     double lo = std::max(v_in, v_out);
     double vpeak = vcap;
     auto needed = [&](double vp) {
@@ -168,7 +174,6 @@ Profile1D build_profile(double length, double v_in, double v_out, double vcap,
     w.ramp(vpeak, v_out, lim);
     prof.duration_s = w.time();
     prof.peak_v_mm_s = vpeak;
-    return prof;
 }
 
 }  // namespace motion

@@ -142,7 +142,9 @@ class Planner {
     // End speed of group g entered at v: as high as reachable, at most `bound`.
     double forward_speed(const Group& g, double v, double bound) const;
     void emit_group(const Group& g, double v_in, double v_out);
-    void emit(const Item& it, const Profile1D& prof);
+    // make_profile(Profile1D&) writes the record's profile into the default one it is given.
+    template <class MakeProfile>
+    void emit(const Item& it, MakeProfile&& make_profile);
 
     PlannerConfig cfg_;
     AxisArray last_end_;

@@ -61,5 +61,9 @@ double reachable_speed_mm_s(double v0_mm_s, double length_mm, const TangentLimit
 // guarantees ramp_distance_mm(v_in, v_out) <= length_mm (up to rounding).
 Profile1D build_profile(double length_mm, double v_in_mm_s, double v_out_mm_s, double vcap_mm_s,
                         const TangentLimits& lim) noexcept;
+// The same, written into `out`, which must be a default Profile1D (the planner builds it in the
+// record it emits).
+void build_profile_into(Profile1D& out, double length_mm, double v_in_mm_s, double v_out_mm_s,
+                        double vcap_mm_s, const TangentLimits& lim) noexcept;
 
 }  // namespace motion
