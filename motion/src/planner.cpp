@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -148,8 +149,9 @@ void Planner::reset(const AxisArray& start) {
 
 void Planner::push(const PathSegment& seg) {
     validate_segment(seg);
-    // Aggregate-initialised: the element is built in place, nothing is cleared first.
-    Piece next{
+    // Built in place in the free slot (Piece is trivially destructible): nothing is cleared
+    // first, and it need not be copied when it becomes the pending piece.
+    Piece& next = *::new (static_cast<void*>(&pieces_[1 - pending_])) Piece{
         seg.kind == SegmentKind::Arc ? make_arc(last_end_, seg) : make_line(last_end_, seg.end_mm),
         seg.rapid ? seg.rapid_mm_s : seg.feed_mm_s,
         seg.rapid,
@@ -161,18 +163,18 @@ void Planner::push(const PathSegment& seg) {
         false,
     };
     if (next.geom.length_mm < kMinLength_mm) {
-        if (have_pending_) pending_.exact_stop |= seg.exact_stop;
+        if (have_pending_) pieces_[pending_].exact_stop |= seg.exact_stop;
         return;
     }
     last_end_ = seg.end_mm;
-    if (have_pending_) close_piece(pending_, &next);
-    pending_ = next;
+    if (have_pending_) close_piece(pieces_[pending_], &next);
+    pending_ = 1 - pending_;
     have_pending_ = true;
     if (items_.size() - head_ >= cfg_.window) plan_and_emit(false);
 }
 
 void Planner::finish() {
-    if (have_pending_) close_piece(pending_, nullptr);
+    if (have_pending_) close_piece(pieces_[pending_], nullptr);
     have_pending_ = false;
     if (plan_and_emit(true) > 0) out_.back().program_end = true;
     v_start_ = 0;

@@ -23,6 +23,7 @@
 // segment changes nothing.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -149,7 +150,10 @@ class Planner {
     PlannerConfig cfg_;
     AxisArray last_end_;
     bool have_pending_ = false;
-    Piece pending_{};
+    // The piece waiting for its successor (pieces_[pending_]) and the one being pushed, in
+    // turns: a new piece is built in the free slot instead of being copied in.
+    std::array<Piece, 2> pieces_{};
+    int pending_ = 0;
     std::vector<Item> items_;
     std::size_t head_ = 0;
     double v_start_ = 0;
