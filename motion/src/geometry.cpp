@@ -671,12 +671,11 @@ CornerPath corner_path(const Element& before, double before_mm, const Element& a
     // tangents +-0 (evaluate): equal to fixed and 0 when origin and end are.
     auto at_rest = [&](const Element& e) {
         if (e.kind != ElementKind::Line && e.kind != ElementKind::Arc) return false;
-        bool same = true;
         for (int i = 0; i < path.still_count; ++i) {
             const int k = path.still_axes[i];
-            same &= (e.origin[k] == path.fixed[k]) & (e.end[k] == path.fixed[k]);
+            if (e.origin[k] != path.fixed[k] || e.end[k] != path.fixed[k]) return false;
         }
-        return same;
+        return true;
     };
     path.still_at_rest = at_rest(before) && at_rest(after);
     const double len = before.length_mm;
