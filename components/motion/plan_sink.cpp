@@ -64,6 +64,12 @@ class Sink final : public PlanSink {
     void restart_from(const motion::AxisArray& pos_mm) override {
         planner_.reset(pos_mm);
         pos_mm_ = pos_mm;
+        off_path_ = true;
+    }
+
+    std::optional<motion::AxisArray> standing_off_path_mm() const override {
+        if (!off_path_) return std::nullopt;
+        return to_machine(pos_mm_);
     }
 
     motion::AxisArray to_machine(const motion::AxisArray& pos_mm) const override {
@@ -426,6 +432,7 @@ class Sink final : public PlanSink {
             rethrow_with_file(loc, e);
         }
         pos_mm_ = seg.end_mm;
+        off_path_ = false;
         feeder_.collect();
     }
 
@@ -433,6 +440,7 @@ class Sink final : public PlanSink {
     const FeederConfig& cfg_;
     ProgramFeeder& feeder_;
     motion::AxisArray pos_mm_;
+    bool off_path_ = false;  // pos_mm_ is where a conditional move stopped, not a move's end
     double feed_mm_s_ = 0;
     double rapid_mm_s_ = 0;  // programmed rapid rate; 0 = as fast as the axes allow
     double tolerance_mm_ = cfg_.blend_tolerance_mm;  // the G61/G64 mode in force

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <memory>
+#include <optional>
 
 #include "interp/canon.hpp"
 #include "joint_limits.hpp"
@@ -38,6 +39,10 @@ class PlanSink : public interp::CanonSink {
     // The machine coordinates of a planner-frame position, with the shifts the program has set
     // so far (the ones in force where the planning has got to).
     virtual motion::AxisArray to_machine(const motion::AxisArray& pos_mm) const = 0;
+    // Where the machine stands (machine coordinates) once what is planned has run, when that is
+    // not the end of a programmed move: after restart_from() until the next move. Otherwise
+    // std::nullopt: it stands where the program last moved it.
+    virtual std::optional<motion::AxisArray> standing_off_path_mm() const = 0;
 };
 
 std::unique_ptr<PlanSink> make_plan_sink(motion::Planner& planner, const FeederConfig& cfg,

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <optional>
 #include <stdexcept>
 #include <type_traits>
 #include <utility>
@@ -19,6 +20,44 @@
 #include "plan_sink.hpp"
 
 namespace motioncomp {
+
+namespace {
+
+// What the in-process interpreter's named parameters read. Positions are where the machine
+// stands once everything planned so far has run; the rest is the executor's model. The two
+// positions differ only after a conditional move (G904): the model takes the trip point (see
+// take_probe_result), while the machine stopped a braking distance beyond it and stays there
+// until the next move. #CURMACHPOS is then that stop point, as the interp component reads it
+// live from interp.machine-pos-L, and #CURWORKPOS moves with it (work = machine - offsets).
+class StandingMachine final : public interp::MachineQuery {
+  public:
+    StandingMachine(interp::Executor& exec, const PlanSink& sink) : exec_(exec), sink_(sink) {}
+
+    double machine_pos_mm(interp::Axis axis) override {
+        const std::optional<motion::AxisArray> stand_mm = sink_.standing_off_path_mm();
+        return stand_mm ? (*stand_mm)[static_cast<std::size_t>(axis)] : exec_.machine_pos_mm(axis);
+    }
+    double work_pos_mm(interp::Axis axis) override {
+        return exec_.work_pos_mm(axis) + machine_pos_mm(axis) - exec_.machine_pos_mm(axis);
+    }
+    std::uint64_t input_bits() override { return exec_.input_bits(); }
+    std::uint64_t output_bits() override { return exec_.output_bits(); }
+    double spindle_rpm() override { return exec_.spindle_rpm(); }
+    double mm_per_program_unit() override { return exec_.mm_per_program_unit(); }
+    bool incremental_mode() override { return exec_.incremental_mode(); }
+    bool cycle_return_to_r() override { return exec_.cycle_return_to_r(); }
+    std::optional<double> setting(std::string_view name) override { return exec_.setting(name); }
+    bool can_write_setting(std::string_view name) override { return exec_.can_write_setting(name); }
+    void write_setting(std::string_view name, double value) override {
+        exec_.write_setting(name, value);
+    }
+
+  private:
+    interp::Executor& exec_;
+    const PlanSink& sink_;
+};
+
+}  // namespace
 
 ProgramFeeder::ProgramFeeder(FeederConfig cfg, motion::SpscRing<motion::PreparedSegment>& ring)
     : cfg_(std::move(cfg)), ring_(ring) {}
@@ -70,10 +109,10 @@ bool ProgramFeeder::probe_result_waiting() const noexcept {
 
 // The path goes on from where the conditional move stopped. With the interpreter in-process
 // its model takes the point where the inputs came (the trip point; the machine stands a
-// braking distance beyond it), so an incremental move after the G904 is measured from the
-// touch, and a move that ended without its inputs is the alarm NCX-3 asks for; with the interp
-// component, that component does both (it waits at the barrier it sends after a G904 and
-// reads motion.probe-pos-L and motion.probe-tripped).
+// braking distance beyond it, which #CURMACHPOS reads: StandingMachine), so an incremental
+// move after the G904 is measured from the touch, and a move that ended without its inputs is
+// the alarm NCX-3 asks for; with the interp component, that component does both (it waits at
+// the barrier it sends after a G904 and reads motion.probe-pos-L and motion.probe-tripped).
 void ProgramFeeder::take_probe_result() {
     probe_pending_ = false;
     sink_->restart_from(probe_pos_mm_);
@@ -228,9 +267,9 @@ void ProgramFeeder::open_program() {
         return;
     }
     executor_ = std::make_unique<machine_program::MachineExecutor>(*sink_, cfg_.program_options);
+    machine_ = std::make_unique<StandingMachine>(executor_->executor(), *sink_);
     interpreter_ = std::make_unique<interp::Interpreter>(
-        *executor_, executor_->executor(),
-        machine_program::interpreter_options(cfg_.program_options));
+        *executor_, *machine_, machine_program::interpreter_options(cfg_.program_options));
     machine_program::open_program(*interpreter_, cfg_.program_options, cfg_.program_path);
 }
 

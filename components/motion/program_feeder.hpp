@@ -33,6 +33,7 @@
 namespace interp {
 class Interpreter;
 class CanonSink;
+class MachineQuery;
 }  // namespace interp
 
 namespace machine_program {
@@ -143,6 +144,7 @@ class ProgramFeeder {
     std::unique_ptr<motion::Planner> planner_;
     std::unique_ptr<PlanSink> sink_;
     std::unique_ptr<machine_program::MachineExecutor> executor_;  // saves settings changes
+    std::unique_ptr<interp::MachineQuery> machine_;               // what #CURMACHPOS & co. read
     std::unique_ptr<interp::Interpreter> interpreter_;
     std::unique_ptr<interp::wire::Decoder> decoder_;  // stream mode
     std::deque<motion::PreparedSegment> outbox_;      // planned, in order, not yet in the ring
