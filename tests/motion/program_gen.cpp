@@ -274,9 +274,9 @@ class Checker {
 
   private:
     // How far beyond the allowed tolerance the sample is from segment `line` (or, inside the
-    // blend before it, from the previous segment; or, on the last half of a line, within the
-    // tolerance of the corner at its end: the shift onto an offset corner, Planner's
-    // offset_corner); <= 0 when within.
+    // blend before it, from the previous segment; or, on a line, within the tolerance of the
+    // corner at its end: the shift onto an offset corner, Planner's offset_corner, which may
+    // take all of the line the corner at its start left); <= 0 when within.
     double deviation(const MotionSample& s) {
         std::size_t i = static_cast<std::size_t>(s.line);
         if (i >= elems_.size()) return 1e9;
@@ -289,12 +289,8 @@ class Checker {
             allowed += prog_.segs[i - 1].tolerance_mm * (1 + 1e-6);
         }
         double excess = d - allowed;
-        if (excess > 0 && e.kind == ElementKind::Line) {
-            double along = 0;
-            for (int k = 0; k < kAxes; ++k) along += (s.pos_mm[k] - e.origin[k]) * e.a[k];
-            if (along >= e.length_mm / 2)
-                excess = std::min(excess, own - 1e-7 - prog_.segs[i].tolerance_mm * (1 + 1e-6));
-        }
+        if (excess > 0 && e.kind == ElementKind::Line)
+            excess = std::min(excess, own - 1e-7 - prog_.segs[i].tolerance_mm * (1 + 1e-6));
         return excess;
     }
 
