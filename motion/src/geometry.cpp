@@ -710,6 +710,18 @@ bool bezier_within(const BezierPoints& bezier, const CornerPath& path, double li
     return hull_within(path, limit_mm, still_axes2, piece, dims);
 }
 
+bool corner_piece_within(const BezierPoints& b, const CornerPath& path, double limit_mm) noexcept {
+    // bezier_within would find every still axis still, at distance (p0 - fixed)^2 = 0.
+    if (!path.still_at_rest) return bezier_within(b, path, limit_mm);
+    Hull piece;
+    for (int j = 0; j < path.dims; ++j) {
+        const int k = path.axes[j];
+        piece[0][j] = b.p0[k], piece[1][j] = b.p1[k];
+        piece[2][j] = b.p2[k], piece[3][j] = b.p3[k];
+    }
+    return hull_within(path, limit_mm, 0, piece, path.dims);
+}
+
 bool corner_bezier_within(const AxisArray& p0, const AxisArray& t1, const AxisArray& p3,
                           const AxisArray& t2, double l_mm, const CornerPath& path,
                           double limit_mm, BezierPoints& out) noexcept {

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 #include <new>
-#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -445,17 +444,23 @@ Planner::Junction Planner::offset_corner(const Piece& p, const Piece& next, doub
         b0[k] = c2[k] + lp * t2[k];
         b3[k] = b0[k] + ls2 * t2[k] - d * n2[k];
     }
-    std::optional<BezierPoints> out = corner_bezier_points(a0, t1, a3, t1, ls1 / 2);
-    std::optional<BezierPoints> in = corner_bezier_points(b0, t2, b3, t2, ls2 / 2);
-    if (!out || !in) return none;
-    jn.shift_out = *out, jn.shift_back = *in;
-    Element par = make_parabola(c2, t1, t2, lp);
-    jn.corner = {par.origin, par.a, par.b, par.end};
+    // Every piece is proved within the tolerance of the programmed lines. In the axes neither
+    // line moves, all their points equal the corner's (the terms added to it there are +-0), so
+    // the proofs run in the lines' axes (corner_bezier_within, corner_piece_within). The
+    // parabola's points are make_parabola(c2, t1, t2, lp)'s.
     const CornerPath path = corner_path(p.geom, jn.blend_l_mm, next.geom, jn.cut_after_mm, tol);
     const double limit = kOffsetProofShare * tol;
-    if (!bezier_within(jn.shift_out, path, limit) || !bezier_within(jn.corner, path, limit) ||
-        !bezier_within(jn.shift_back, path, limit))
+    if (!corner_bezier_within(a0, t1, a3, t1, ls1 / 2, path, limit, jn.shift_out) ||
+        !corner_bezier_within(b0, t2, b3, t2, ls2 / 2, path, limit, jn.shift_back))
         return none;
+    BezierPoints& par = jn.corner;
+    for (int k = 0; k < kAxes; ++k) {
+        par.p0[k] = c2[k] - lp * t1[k];
+        par.p3[k] = c2[k] + lp * t2[k];
+        par.p1[k] = par.p0[k] + 2 * lp / 3 * t1[k];
+        par.p2[k] = par.p3[k] - 2 * lp / 3 * t2[k];
+    }
+    if (!corner_piece_within(par, path, limit)) return none;
     return jn;
 }
 

@@ -170,6 +170,12 @@ bool corner_bezier_within(const AxisArray& p0, const AxisArray& t1, const AxisAr
                           const AxisArray& t2, double l_mm, const CornerPath& path,
                           double limit_mm, BezierPoints& out) noexcept;
 
+// bezier_within(b, path, limit_mm) for a Bezier whose four points equal path.fixed in the axes
+// neither move changes (as numbers: +0 and -0 alike), such as one built from the moves' points
+// and tangents: when path.still_at_rest those axes add exact zeros to every distance, so the
+// proof runs in the path's axes only.
+bool corner_piece_within(const BezierPoints& b, const CornerPath& path, double limit_mm) noexcept;
+
 // make_bezier(b.p0, b.p1, b.p2, b.p3) for points corner_bezier_within() gave for this path: when
 // path.still_at_rest they do not differ in the still axes, so the length's sums run over the
 // path's axes only.
