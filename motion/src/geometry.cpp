@@ -291,16 +291,11 @@ Element make_blend(const AxisArray& corner, const AxisArray& t1, const AxisArray
 
 namespace {
 
-// make_bezier, its length summed over the listed axes (Axes as for the evaluators).
+// A Bezier's pseudo length (see make_bezier), summed over the listed axes (Axes as for the
+// evaluators).
 template <class Axes>
-Element bezier_in(const AxisArray& p0, const AxisArray& p1, const AxisArray& p2,
-                  const AxisArray& p3, Axes ax) {
-    Element e;
-    e.kind = ElementKind::Bezier;
-    e.origin = p0;
-    e.a = p1;
-    e.b = p2;
-    e.end = p3;
+double bezier_length_in(const AxisArray& p0, const AxisArray& p1, const AxisArray& p2,
+                        const AxisArray& p3, Axes ax) {
     double n0 = 0, n1 = 0, n2 = 0;
     for (int j = 0; j < ax.count(); ++j) {
         const int k = ax[j];
@@ -308,22 +303,39 @@ Element bezier_in(const AxisArray& p0, const AxisArray& p1, const AxisArray& p2,
         n1 += (p2[k] - p1[k]) * (p2[k] - p1[k]);
         n2 += (p3[k] - p2[k]) * (p3[k] - p2[k]);
     }
-    e.length_mm = 3 * std::sqrt(std::max({n0, n1, n2}));
-    return e;
+    return 3 * std::sqrt(std::max({n0, n1, n2}));
 }
 
 }  // namespace
 
 Element make_bezier(const AxisArray& p0, const AxisArray& p1, const AxisArray& p2,
                     const AxisArray& p3) noexcept {
-    return bezier_in(p0, p1, p2, p3, AllAxes{});
+    Element e;
+    e.kind = ElementKind::Bezier;
+    e.origin = p0;
+    e.a = p1;
+    e.b = p2;
+    e.end = p3;
+    e.length_mm = bezier_length_in(p0, p1, p2, p3, AllAxes{});
+    return e;
 }
 
-Element make_corner_bezier(const BezierPoints& b, const CornerPath& path) noexcept {
+void make_corner_bezier(const BezierPoints& b, const CornerPath& path, Element& out) noexcept {
+    // Every member as make_bezier's new Element has it.
+    out.kind = ElementKind::Bezier;
+    out.origin = b.p0;
+    out.a = b.p1;
+    out.b = b.p2;
+    out.end = b.p3;
+    out.c = {};
+    out.radius_mm = 0;
+    out.theta0_rad = 0;
+    out.sweep_rad = 0;
     // The still axes' differences are +-0 (corner_bezier_within), which add nothing.
-    if (path.still_at_rest)
-        return bezier_in(b.p0, b.p1, b.p2, b.p3, ListedAxes{path.axes.data(), path.dims});
-    return make_bezier(b.p0, b.p1, b.p2, b.p3);
+    out.length_mm =
+        path.still_at_rest
+            ? bezier_length_in(b.p0, b.p1, b.p2, b.p3, ListedAxes{path.axes.data(), path.dims})
+            : bezier_length_in(b.p0, b.p1, b.p2, b.p3, AllAxes{});
 }
 
 Element make_parabola(const AxisArray& corner, const AxisArray& t1, const AxisArray& t2,

@@ -179,8 +179,8 @@ void Planner::finish() {
     v_start_ = 0;
 }
 
-Planner::Junction Planner::classify(const Piece& p, const Piece& next) const {
-    if (p.exact_stop) return {0, false, 0};
+void Planner::classify(const Piece& p, const Piece& next, Junction& jn) const {
+    if (p.exact_stop) return jn.set(0, false, 0);
     // p'' only for the curvature steps, which cost nothing without a jerk limit.
     EndDerivs pe = end_derivs(p.geom, jerk_mode_);
     EndDerivs ns = start_derivs(next.geom, jerk_mode_);
@@ -193,7 +193,7 @@ Planner::Junction Planner::classify(const Piece& p, const Piece& next) const {
     }
     const AxisLimits& lim = cfg_.limits;
     double curvature_cap = curvature_step_cap(pe.d2, ns.d2);
-    if (dmax <= kTangentEps) return {curvature_cap, std::isfinite(curvature_cap), 0};
+    if (dmax <= kTangentEps) return jn.set(curvature_cap, std::isfinite(curvature_cap), 0);
     // The blends' distance from the programmed path grows with sin(angle) (geometry.hpp); past
     // 90 degrees |T2 - T1| / sqrt(2) is used instead, so that a reversal does not spend half of
     // each move on a slow turn.
@@ -227,7 +227,7 @@ Planner::Junction Planner::classify(const Piece& p, const Piece& next) const {
         // A (near) reversal stops at its end point: the axis passes through zero speed there
         // anyway, so a blend saves almost nothing and would leave the bottom of a drilled
         // hole sqrt(2) tol short (the miss every turn past 90 degrees is allowed, see above).
-        if (cos_angle < kReversalCos) return {0, false, 0};
+        if (cos_angle < kReversalCos) return jn.set(0, false, 0);
         // Without a jerk limit the parabola (the per-axis bang-bang corner) is the fastest;
         // its distance from the lines is (l / 4) sin(angle) (geometry.hpp). When the
         // tolerance keeps it slower than the moves allow, the corner is cut on offset lines
@@ -235,15 +235,13 @@ Planner::Junction Planner::classify(const Piece& p, const Piece& next) const {
         if (!jerk_mode_) {
             double l_tol = p.tolerance_mm / (kParabolaDeviationPerL * sin_angle);
             double l_geom = std::min(l, l_tol);
-            if (l_speed_mm > l_tol && l > l_tol) {
-                Junction jn = offset_corner(p, next, sin_angle, l_speed_mm);
-                if (jn.blend == Blend::Offset) return jn;
-            }
+            if (l_speed_mm > l_tol && l > l_tol && offset_corner(p, next, sin_angle, l_speed_mm, jn))
+                return;
             l = cut_for_speed(l_geom, l_speed_mm);
-            if (l > kMinLength_mm) return {kInf, false, l, Blend::Parabola};
+            if (l > kMinLength_mm) return jn.set(kInf, false, l, Blend::Parabola);
         } else {
             l = std::min(l, p.tolerance_mm / (kBlendDeviationPerL * sin_angle));
-            if (l > kMinLength_mm) return {kInf, false, l, Blend::Quartic};
+            if (l > kMinLength_mm) return jn.set(kInf, false, l, Blend::Quartic);
         }
     }
     // A kink that is not blended: pass it only as fast as a velocity step of junction_share of
@@ -275,12 +273,11 @@ Planner::Junction Planner::classify(const Piece& p, const Piece& next) const {
     }
     // Kinks with an arc (rounding in the program, or a real corner): a blend where passing
     // the kink would cost speed.
-    if (cap < feed && p.tolerance_mm > 0 && sin_angle < kMaxArcBlendSin) {
-        Junction jn = bezier_corner(p, next, sin_angle, feed, l_speed_mm);
-        if (jn.blend_l_mm > 0) return jn;
-    }
-    if (cap < kKinkStopFraction * feed) return {0, false, 0};
-    return {std::min(cap, curvature_cap), true, 0};
+    if (cap < feed && p.tolerance_mm > 0 && sin_angle < kMaxArcBlendSin &&
+        bezier_corner(p, next, sin_angle, feed, l_speed_mm, jn))
+        return;
+    if (cap < kKinkStopFraction * feed) return jn.set(0, false, 0);
+    jn.set(std::min(cap, curvature_cap), true, 0);
 }
 
 double Planner::curvature_step_cap(const AxisArray& d2_before, const AxisArray& d2_after) const {
@@ -317,8 +314,8 @@ Element trimmed(const Element& e, double from_mm, double to_mm,
 
 }  // namespace
 
-Planner::Junction Planner::bezier_corner(const Piece& p, const Piece& next, double sin_angle,
-                                         double feed_mm_s, double l_speed_mm) const {
+bool Planner::bezier_corner(const Piece& p, const Piece& next, double sin_angle, double feed_mm_s,
+                            double l_speed_mm, Junction& jn) const {
     const double tol = p.tolerance_mm;
     double l_max = std::min(max_trim_mm(p.geom, p.trim_start_mm), max_trim_mm(next.geom, 0));
     // For two lines the parabola's distance from them is exactly (l / 4) sin(angle); with an
@@ -352,7 +349,7 @@ Planner::Junction Planner::bezier_corner(const Piece& p, const Piece& next, doub
         l_fail = l;
         l *= attempt == 0 ? kBlendFirstShrink : 0.7;
     }
-    if (!found) return {0, false, 0};
+    if (!found) return false;
     for (int i = 0; i < kBlendBisections && l_fail > l / kBlendFirstShrink * (1 + 1e-9); ++i) {
         double mid = std::sqrt(l * l_fail);
         if (fits(mid, trial))
@@ -361,10 +358,11 @@ Planner::Junction Planner::bezier_corner(const Piece& p, const Piece& next, doub
             l_fail = mid;
     }
     const CurvePoint &a = fit.a, &b = fit.b;
-    Junction jn{kInf, false, l, Blend::Curve};
-    jn.curve = make_corner_bezier(fit.ctrl, path);
+    jn.set(kInf, false, l, Blend::Curve);
+    make_corner_bezier(fit.ctrl, path, jn.curve);
     jn.curve_end_cap_mm_s = kInf;
-    if (!jerk_mode_) return jn;  // without a jerk limit curvature steps cost nothing
+    jn.curve_end_rough = false;
+    if (!jerk_mode_) return true;  // without a jerk limit curvature steps cost nothing
     EndDerivs bs = start_derivs(jn.curve), be = end_derivs(jn.curve);
     jn.cap_mm_s = curvature_step_cap(a.d2, bs.d2);
     jn.rough = std::isfinite(jn.cap_mm_s);
@@ -373,8 +371,8 @@ Planner::Junction Planner::bezier_corner(const Piece& p, const Piece& next, doub
     // The steps make the neighbours give up the junction share: only worth it when the
     // corner can then be taken at a good part of the feed.
     if (std::min(jn.cap_mm_s, jn.curve_end_cap_mm_s) < kJerkBlendMinFeedShare * feed_mm_s)
-        return {0, false, 0};
-    return jn;
+        return false;
+    return true;
 }
 
 // The offset corner (no jerk limit; two lines turning by up to about 90 degrees). The parabola
@@ -392,13 +390,12 @@ Planner::Junction Planner::bezier_corner(const Piece& p, const Piece& next, doub
 // allows (docs/benchmarks.md, the acceleration-aware bound). The path is 2 d tan(angle / 2)
 // longer, the shifts need room on both lines, and each piece is proved within the tolerance
 // (bezier_within against the programmed lines); otherwise the caller uses the parabola.
-Planner::Junction Planner::offset_corner(const Piece& p, const Piece& next, double sin_angle,
-                                         double l_speed_mm) const {
-    const Junction none{0, false, 0};
+bool Planner::offset_corner(const Piece& p, const Piece& next, double sin_angle,
+                            double l_speed_mm, Junction& jn) const {
     const AxisArray &t1 = p.geom.a, &t2 = next.geom.a, &c = p.geom.end;
     double cos_t = 0;
     for (int k = 0; k < kAxes; ++k) cos_t += t1[k] * t2[k];
-    if (cos_t < kOffsetMinCos) return none;
+    if (cos_t < kOffsetMinCos) return false;
     const double sin_t = std::sqrt(std::max(0.0, 1 - cos_t * cos_t));
     const double tol = p.tolerance_mm;
     // The parabola may now lie up to d + kOffsetShare tol from the offset lines; it is cut no
@@ -409,7 +406,7 @@ Planner::Junction Planner::offset_corner(const Piece& p, const Piece& next, doub
     const double d = std::clamp(lp * kParabolaDeviationPerL * sin_angle - kOffsetShare * tol,
                                 kOffsetMinShare * tol, kOffsetShare * tol);
     const double back = d * (1 - cos_t) / sin_t;  // d tan(angle / 2)
-    if (!(lp > back)) return none;
+    if (!(lp > back)) return false;
     // The parabola's speed (second derivative (t2 - t1) / 2 lp), and the shift length that
     // lets a shift pass at kShiftSpeedFactor times it on kShiftCentripetal of the acceleration
     // (a shift's sideways second derivative peaks at 6 d / ls^2). A much shorter shift caps
@@ -432,9 +429,8 @@ Planner::Junction Planner::offset_corner(const Piece& p, const Piece& next, doub
     const double ls1 = std::min(ls, p.geom.length_mm - p.trim_start_mm - (lp - back));
     const double ls2 = std::min(ls, max_trim_mm(next.geom, 0) - (lp - back));
     const double keep = kShiftMinSpeedFactor / kShiftSpeedFactor;
-    if (ls1 < keep * ls || ls2 < keep * ls) return none;
-    Junction jn{kInf, false, lp - back + ls1, Blend::Offset};
-    jn.cut_after_mm = lp - back + ls2;
+    if (ls1 < keep * ls || ls2 < keep * ls) return false;
+    const double cut_before_mm = lp - back + ls1, cut_after_mm = lp - back + ls2;
     // The offset corner c2 is d from both lines, outwards; a0 and b3 lie on the programmed lines.
     AxisArray c2, a0, a3, b0, b3;
     for (int k = 0; k < kAxes; ++k) {
@@ -448,24 +444,33 @@ Planner::Junction Planner::offset_corner(const Piece& p, const Piece& next, doub
     // line moves, all their points equal the corner's (the terms added to it there are +-0), so
     // the proofs run in the lines' axes (corner_bezier_within, corner_piece_within). The
     // parabola's points are make_parabola(c2, t1, t2, lp)'s.
-    const CornerPath path = corner_path(p.geom, jn.blend_l_mm, next.geom, jn.cut_after_mm, tol);
+    const CornerPath path = corner_path(p.geom, cut_before_mm, next.geom, cut_after_mm, tol);
     const double limit = kOffsetProofShare * tol;
-    if (!corner_bezier_within(a0, t1, a3, t1, ls1 / 2, path, limit, jn.shift_out) ||
-        !corner_bezier_within(b0, t2, b3, t2, ls2 / 2, path, limit, jn.shift_back))
-        return none;
-    BezierPoints& par = jn.corner;
+    BezierPoints out, par, in;
+    if (!corner_bezier_within(a0, t1, a3, t1, ls1 / 2, path, limit, out) ||
+        !corner_bezier_within(b0, t2, b3, t2, ls2 / 2, path, limit, in))
+        return false;
     for (int k = 0; k < kAxes; ++k) {
         par.p0[k] = c2[k] - lp * t1[k];
         par.p3[k] = c2[k] + lp * t2[k];
         par.p1[k] = par.p0[k] + 2 * lp / 3 * t1[k];
         par.p2[k] = par.p3[k] - 2 * lp / 3 * t2[k];
     }
-    if (!corner_piece_within(par, path, limit)) return none;
-    return jn;
+    if (!corner_piece_within(par, path, limit)) return false;
+    jn.set(kInf, false, cut_before_mm, Blend::Offset);
+    jn.cut_after_mm = cut_after_mm;
+    make_corner_bezier(out, path, jn.shift_out);
+    make_corner_bezier(par, path, jn.curve);
+    make_corner_bezier(in, path, jn.shift_back);
+    return true;
 }
 
 void Planner::close_piece(Piece& p, Piece* next) {
-    Junction jn = next ? classify(p, *next) : Junction{0, false, 0};
+    Junction& jn = junction_;
+    if (next)
+        classify(p, *next, jn);
+    else
+        jn.set(0, false, 0);
     bool rough = p.rough_start || jn.rough;
     // A Bezier corner starts where the move is cut (bezier_corner evaluated it there).
     Element e = trimmed(p.geom, p.trim_start_mm, jn.blend_l_mm,
@@ -485,17 +490,13 @@ void Planner::close_piece(Piece& p, Piece* next) {
     double turning = isolated ? kIsolatedBlendCentripetal : 0;
     switch (jn.blend) {
         case Blend::Offset: {
-            Element out =
-                make_bezier(jn.shift_out.p0, jn.shift_out.p1, jn.shift_out.p2, jn.shift_out.p3);
             // The shift runs along the first move (its line and move; a single block stop
             // comes at its end, within the tolerance); the turn belongs to the next move, as
             // every blend does (synchronised outputs switch where it starts).
-            add_item(out, p.feed_mm_s, kInf, false, p, p.rapid, kShiftCentripetal);
-            Element corner = make_bezier(jn.corner.p0, jn.corner.p1, jn.corner.p2, jn.corner.p3);
-            add_item(corner, feed, kInf, false, *next, rapid, kIsolatedBlendCentripetal);
-            Element back =
-                make_bezier(jn.shift_back.p0, jn.shift_back.p1, jn.shift_back.p2, jn.shift_back.p3);
-            add_item(back, next->feed_mm_s, kInf, false, *next, next->rapid, kShiftCentripetal);
+            add_item(jn.shift_out, p.feed_mm_s, kInf, false, p, p.rapid, kShiftCentripetal);
+            add_item(jn.curve, feed, kInf, false, *next, rapid, kIsolatedBlendCentripetal);
+            add_item(jn.shift_back, next->feed_mm_s, kInf, false, *next, next->rapid,
+                     kShiftCentripetal);
             next->trim_start_mm = jn.cut_after_mm;
             next->rough_start = false;
             return;

@@ -176,9 +176,10 @@ bool corner_bezier_within(const AxisArray& p0, const AxisArray& t1, const AxisAr
 // proof runs in the path's axes only.
 bool corner_piece_within(const BezierPoints& b, const CornerPath& path, double limit_mm) noexcept;
 
-// make_bezier(b.p0, b.p1, b.p2, b.p3) for points corner_bezier_within() gave for this path: when
-// path.still_at_rest they do not differ in the still axes, so the length's sums run over the
-// path's axes only.
-Element make_corner_bezier(const BezierPoints& b, const CornerPath& path) noexcept;
+// out = make_bezier(b.p0, b.p1, b.p2, b.p3), written in place, for points corner_bezier_within()
+// gave for this path (or any whose points equal path.fixed in the still axes, as for
+// corner_piece_within): when path.still_at_rest they do not differ in the still axes, so the
+// length's sums run over the path's axes only.
+void make_corner_bezier(const BezierPoints& b, const CornerPath& path, Element& out) noexcept;
 
 }  // namespace motion

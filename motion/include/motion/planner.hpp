@@ -105,30 +105,36 @@ class Planner {
         TangentLimits tangent;
     };
     enum class Blend : std::uint8_t { None, Quartic, Parabola, Curve, Offset };
+    // What classify() decides for the junction after a piece. Filled in place in junction_ (the
+    // elements make it about 1.3 kB): only the members the blend kind names are set.
     struct Junction {
         double cap_mm_s;    // speed limit where the first piece ends (at the blend if any)
         bool rough;         // that junction is not smooth
         double blend_l_mm;  // > 0: insert a blend cutting this much from both sides
-        Blend blend = Blend::None;
-        Element curve{};                // the Bezier blend, for Blend::Curve
-        double curve_end_cap_mm_s = 0;  // speed limit where the Bezier blend ends
+        Blend blend;
+        Element curve;                  // Curve: the Bezier blend; Offset: the parabola
+        double curve_end_cap_mm_s = 0;  // Curve: speed limit where the Bezier blend ends
         bool curve_end_rough = false;   // that junction is not smooth
-        // Blend::Offset (two lines, no jerk limit): shift out, parabola, shift back; the
-        // first move loses blend_l_mm, the second cut_after_mm.
-        BezierPoints shift_out{}, corner{}, shift_back{};
+        // Blend::Offset (two lines, no jerk limit): shift out, parabola (curve), shift back;
+        // the first move loses blend_l_mm, the second cut_after_mm.
+        Element shift_out, shift_back;
         double cut_after_mm = 0;
+
+        void set(double cap, bool is_rough, double l_mm, Blend kind = Blend::None) {
+            cap_mm_s = cap, rough = is_rough, blend_l_mm = l_mm, blend = kind;
+        }
     };
 
-    Junction classify(const Piece& p, const Piece& next) const;
-    // A Bezier blend for a corner with an arc (or any corner without a jerk limit), or none
-    // (blend_l_mm = 0) when no blend within the tolerance fits.
+    void classify(const Piece& p, const Piece& next, Junction& jn) const;
+    // A Bezier blend for a corner with an arc (or any corner without a jerk limit) written into
+    // jn, or false (jn's blend members left undefined) when no blend within the tolerance fits.
     // l_speed_mm: the longest cut worth making (see classify).
-    Junction bezier_corner(const Piece& p, const Piece& next, double sin_angle, double feed_mm_s,
-                           double l_speed_mm) const;
-    // The corner of two lines cut on lines moved outwards (see planner.cpp), or none
-    // (blend_l_mm = 0) when that does not fit.
-    Junction offset_corner(const Piece& p, const Piece& next, double sin_angle,
-                           double l_speed_mm) const;
+    bool bezier_corner(const Piece& p, const Piece& next, double sin_angle, double feed_mm_s,
+                       double l_speed_mm, Junction& jn) const;
+    // The corner of two lines cut on lines moved outwards (see planner.cpp) written into jn, or
+    // false (as above) when that does not fit.
+    bool offset_corner(const Piece& p, const Piece& next, double sin_angle, double l_speed_mm,
+                       Junction& jn) const;
     // Highest speed at which a step between these second derivatives stays within the
     // junction share of one period's jerk (infinite without a jerk limit).
     double curvature_step_cap(const AxisArray& d2_before, const AxisArray& d2_after) const;
@@ -164,6 +170,7 @@ class Planner {
     std::vector<PreparedSegment> out_;
     std::size_t out_head_ = 0;
     std::uint32_t seq_ = 0;
+    Junction junction_{};  // close_piece's, reused: clearing 1.3 kB per junction cost more
     bool jerk_mode_ = false;
     double reserve_ = 0;  // override_reserve_in_effect(cfg_)
 };
