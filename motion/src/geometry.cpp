@@ -467,26 +467,28 @@ std::uint64_t magnitude_bits(double x) {
     return u << 1;
 }
 
+// x != y as an integer, for | without a branch per test (|| would branch on each).
+unsigned differs(double x, double y) { return x != y; }
+
 void mark_moving_axes(const Element& e, std::array<bool, kAxes>& moving) {
     // x != 0 as integer tests and | rather than ||: no branch per axis.
     switch (e.kind) {
         case ElementKind::Line:
-            for (int k = 0; k < kAxes; ++k) moving[k] = moving[k] | (magnitude_bits(e.a[k]) != 0);
+            for (int k = 0; k < kAxes; ++k) moving[k] |= magnitude_bits(e.a[k]) != 0;
             return;
         case ElementKind::Arc:
             for (int k = 0; k < kAxes; ++k)
-                moving[k] = moving[k] | ((magnitude_bits(e.a[k]) | magnitude_bits(e.b[k]) |
-                                          magnitude_bits(e.c[k])) != 0);
+                moving[k] |=
+                    (magnitude_bits(e.a[k]) | magnitude_bits(e.b[k]) | magnitude_bits(e.c[k])) != 0;
             return;
         case ElementKind::Blend:
             for (int k = 0; k < kAxes; ++k)
-                moving[k] =
-                    moving[k] | ((magnitude_bits(e.a[k]) | magnitude_bits(e.b[k])) != 0);
+                moving[k] |= (magnitude_bits(e.a[k]) | magnitude_bits(e.b[k])) != 0;
             return;
         case ElementKind::Bezier:
             for (int k = 0; k < kAxes; ++k)
-                moving[k] = moving[k] | (e.a[k] != e.origin[k]) | (e.b[k] != e.origin[k]) |
-                            (e.end[k] != e.origin[k]);
+                moving[k] |= differs(e.a[k], e.origin[k]) | differs(e.b[k], e.origin[k]) |
+                             differs(e.end[k], e.origin[k]);
             return;
     }
     moving.fill(true);
@@ -709,7 +711,7 @@ bool bezier_within(const BezierPoints& bezier, const CornerPath& path, double li
     for (int k = 0; k < kAxes; ++k) {
         if (path.moving[k]) continue;
         const double x0 = bezier.p0[k];
-        if ((bezier.p1[k] != x0) | (bezier.p2[k] != x0) | (bezier.p3[k] != x0)) {
+        if (differs(bezier.p1[k], x0) | differs(bezier.p2[k], x0) | differs(bezier.p3[k], x0)) {
             piece[0][dims] = bezier.p0[k] - path.fixed[k];
             piece[1][dims] = bezier.p1[k] - path.fixed[k];
             piece[2][dims] = bezier.p2[k] - path.fixed[k];
