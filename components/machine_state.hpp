@@ -8,9 +8,12 @@
 
 #include <fmt/format.h>
 
+#include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
 
 #include "interp/block.hpp"
@@ -136,6 +139,35 @@ class MachineExecutor final : public interp::BlockExecutor {
     StateSaver saver_;
     interp::Executor exec_;
     interp::SourceLoc at_;  // the block being executed
+};
+
+// What named parameters read on a machine: the executor's model for everything, so that a
+// program path overrides only what its machine knows better (positions, I/O, the spindle).
+// Work positions follow the machine position with the interpreter's offsets (work = machine
+// - offsets), whoever answers the machine position.
+class ModelQuery : public interp::MachineQuery {
+  public:
+    explicit ModelQuery(interp::Executor& exec) : exec_(exec) {}
+
+    double machine_pos_mm(interp::Axis axis) override { return exec_.machine_pos_mm(axis); }
+    double work_pos_mm(interp::Axis axis) override {
+        return exec_.work_pos_mm(axis) + machine_pos_mm(axis) - exec_.machine_pos_mm(axis);
+    }
+    std::uint64_t input_bits() override { return exec_.input_bits(); }
+    std::uint64_t output_bits() override { return exec_.output_bits(); }
+    double spindle_rpm() override { return exec_.spindle_rpm(); }
+    double mm_per_program_unit() override { return exec_.mm_per_program_unit(); }
+    bool incremental_mode() override { return exec_.incremental_mode(); }
+    bool cycle_return_to_r() override { return exec_.cycle_return_to_r(); }
+    std::optional<double> setting(std::string_view name) override { return exec_.setting(name); }
+    // Writable named parameters (#FIXEDCALI_REC) persist in the executor's settings.
+    bool can_write_setting(std::string_view name) override { return exec_.can_write_setting(name); }
+    void write_setting(std::string_view name, double value) override {
+        exec_.write_setting(name, value);
+    }
+
+  protected:
+    interp::Executor& exec_;
 };
 
 }  // namespace machine_program

@@ -44,19 +44,14 @@ class ProgramRunner::Sink final : public interp::CanonSink {
 // machine's live ones after a barrier (motion has followed everything sent and stands in
 // position); modal state and settings come from the executor's model. Standalone, everything
 // comes from the model.
-class ProgramRunner::LiveMachine final : public interp::MachineQuery {
+class ProgramRunner::LiveMachine final : public machine_program::ModelQuery {
   public:
-    LiveMachine(ProgramRunner& runner, interp::Executor& exec) : runner_(runner), exec_(exec) {}
+    LiveMachine(ProgramRunner& runner, interp::Executor& exec) : ModelQuery(exec), runner_(runner) {}
 
     double machine_pos_mm(interp::Axis axis) override {
         if (runner_.cfg_.standalone) return exec_.machine_pos_mm(axis);
-        if (!runner_.machine_current()) runner_.sync(runner_.last_loc_);
+        sync_if_behind();
         return runner_.link_.machine_pos_mm(static_cast<int>(axis));
-    }
-    // The work offsets are the interpreter's: work = machine - (model machine - model work).
-    double work_pos_mm(interp::Axis axis) override {
-        const double offset_mm = exec_.machine_pos_mm(axis) - exec_.work_pos_mm(axis);
-        return machine_pos_mm(axis) - offset_mm;
     }
     std::uint64_t input_bits() override {
         if (runner_.cfg_.standalone) return exec_.input_bits();
@@ -73,15 +68,6 @@ class ProgramRunner::LiveMachine final : public interp::MachineQuery {
         sync_if_behind();
         return runner_.link_.spindle_rpm();
     }
-    double mm_per_program_unit() override { return exec_.mm_per_program_unit(); }
-    bool incremental_mode() override { return exec_.incremental_mode(); }
-    bool cycle_return_to_r() override { return exec_.cycle_return_to_r(); }
-    std::optional<double> setting(std::string_view name) override { return exec_.setting(name); }
-    // Writable named parameters (#FIXEDCALI_REC) persist in the executor's settings.
-    bool can_write_setting(std::string_view name) override { return exec_.can_write_setting(name); }
-    void write_setting(std::string_view name, double value) override {
-        exec_.write_setting(name, value);
-    }
 
   private:
     void sync_if_behind() {
@@ -89,7 +75,6 @@ class ProgramRunner::LiveMachine final : public interp::MachineQuery {
     }
 
     ProgramRunner& runner_;
-    interp::Executor& exec_;
 };
 
 ProgramRunner::ProgramRunner(RunnerConfig cfg, MachineLink& link)

@@ -29,31 +29,16 @@ namespace {
 // take_probe_result), while the machine stopped a braking distance beyond it and stays there
 // until the next move. #CURMACHPOS is then that stop point, as the interp component reads it
 // live from interp.machine-pos-L, and #CURWORKPOS moves with it (work = machine - offsets).
-class StandingMachine final : public interp::MachineQuery {
+class StandingMachine final : public machine_program::ModelQuery {
   public:
-    StandingMachine(interp::Executor& exec, const PlanSink& sink) : exec_(exec), sink_(sink) {}
+    StandingMachine(interp::Executor& exec, const PlanSink& sink) : ModelQuery(exec), sink_(sink) {}
 
     double machine_pos_mm(interp::Axis axis) override {
         const std::optional<motion::AxisArray> stand_mm = sink_.standing_off_path_mm();
         return stand_mm ? (*stand_mm)[static_cast<std::size_t>(axis)] : exec_.machine_pos_mm(axis);
     }
-    double work_pos_mm(interp::Axis axis) override {
-        return exec_.work_pos_mm(axis) + machine_pos_mm(axis) - exec_.machine_pos_mm(axis);
-    }
-    std::uint64_t input_bits() override { return exec_.input_bits(); }
-    std::uint64_t output_bits() override { return exec_.output_bits(); }
-    double spindle_rpm() override { return exec_.spindle_rpm(); }
-    double mm_per_program_unit() override { return exec_.mm_per_program_unit(); }
-    bool incremental_mode() override { return exec_.incremental_mode(); }
-    bool cycle_return_to_r() override { return exec_.cycle_return_to_r(); }
-    std::optional<double> setting(std::string_view name) override { return exec_.setting(name); }
-    bool can_write_setting(std::string_view name) override { return exec_.can_write_setting(name); }
-    void write_setting(std::string_view name, double value) override {
-        exec_.write_setting(name, value);
-    }
 
   private:
-    interp::Executor& exec_;
     const PlanSink& sink_;
 };
 
