@@ -30,16 +30,10 @@ std::string mill_ini_plus(const fs::path& extra_hal) {
     });
 }
 
-// A tool setter under the spindle: input 3 (dio-in-03) closes while Z is below `z_mm`.
+// configs/sim/mill.ini with a tool setter (cnc_test::tool_setter_hal) closing below Z `z_mm`.
 fs::path tool_setter_ini(const fs::path& dir, double z_mm) {
-    const fs::path hal = dir / "setter.hal";
-    std::ofstream(hal) << "loadrt comp names=setter\n"
-                          "addf setter servo-thread\n"
-                          "net z-pos-cmd => setter.in0\n"
-                       << fmt::format("setp setter.in1 {}\n", z_mm)
-                       << "net dio-in-03 <= setter.out\n";
     const fs::path ini = dir / "setter.ini";
-    std::ofstream(ini) << mill_ini_plus(hal);
+    std::ofstream(ini) << mill_ini_plus(cnc_test::tool_setter_hal(dir, z_mm));
     return ini;
 }
 

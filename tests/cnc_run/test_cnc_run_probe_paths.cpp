@@ -28,17 +28,6 @@ using cnc_test::RunResult;
 using cnc_test::ScratchDir;
 using cnc_test::slurp;
 
-// A tool setter under the spindle: input 3 (dio-in-03) closes while Z is below -12.5.
-fs::path setter_hal(const fs::path& dir) {
-    const fs::path hal = dir / "setter.hal";
-    std::ofstream(hal) << "loadrt comp names=setter\n"
-                          "addf setter servo-thread\n"
-                          "net z-pos-cmd => setter.in0\n"
-                          "setp setter.in1 -12.5\n"
-                          "net dio-in-03 <= setter.out\n";
-    return hal;
-}
-
 // halfiles/motion_xyz.hal with motion running the program itself (program=, the same INI and
 // settings folder the interp component would get) and everything that talks to the interp
 // component left out; the machine's inputs go to motion alone.
@@ -76,7 +65,7 @@ void PrintTo(Path p, std::ostream* os) {
 // configs/sim/mill.ini plus the setter; on the motion path its mill-motion.hal sources the
 // edited motion_xyz.hal instead of the stock one.
 fs::path setter_ini(const fs::path& dir, Path path) {
-    const fs::path setter = setter_hal(dir);
+    const fs::path setter = cnc_test::tool_setter_hal(dir, -12.5);
     fs::path motion_hal;
     if (path == Path::MotionProgram) {
         motion_hal = dir / "feeder-motion.hal";

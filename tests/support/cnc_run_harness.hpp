@@ -77,6 +77,18 @@ inline std::string sim_ini(const std::string& name, const IniEdit& edit = {}) {
     return text;
 }
 
+// A HAL file for a tool setter under the spindle of a sim config with motion_xyz.hal: input 3
+// (dio-in-03) closes while the commanded Z is below `z_mm`. Written into `dir`; returns its path.
+inline fs::path tool_setter_hal(const fs::path& dir, double z_mm) {
+    const fs::path hal = dir / "setter.hal";
+    std::ofstream(hal) << "loadrt comp names=setter\n"
+                          "addf setter servo-thread\n"
+                          "net z-pos-cmd => setter.in0\n"
+                       << fmt::format("setp setter.in1 {}\n", z_mm)
+                       << "net dio-in-03 <= setter.out\n";
+    return hal;
+}
+
 // `cnc run ARGS` in `cwd`; stdout and stderr go through files in `scratch`. Unless ARGS name
 // one, the machine's settings file and tool table are kept in `scratch`/settings
 // (--settings-dir), so a test never writes into configs/ nor sees another test's offsets.
