@@ -4,17 +4,16 @@
 // (components/machine_state.hpp: load_state, StateSaver). End to end: tests/cnc_run
 // test_cnc_run_settings.cpp and tests/hal/interp-settings-*.
 #include <gtest/gtest.h>
-#include <stdlib.h>
 
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include "hal/ini.hpp"
 #include "hal/types.hpp"
 #include "machine_program_ini.hpp"
 #include "machine_state.hpp"
+#include "scratch_dir.hpp"
 
 namespace {
 
@@ -34,25 +33,11 @@ std::string error_of(const std::string& text, const std::string& settings_dir = 
     return "no error";
 }
 
-std::string read(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
+// Each test's own folder, removed after it.
 class Folder : public ::testing::Test {
   protected:
-    void SetUp() override {
-        std::string tmpl = (fs::temp_directory_path() / "machine-state.XXXXXX").string();
-        ASSERT_NE(::mkdtemp(tmpl.data()), nullptr);
-        dir_ = tmpl;
-    }
-    void TearDown() override {
-        std::error_code ec;
-        fs::remove_all(dir_, ec);
-    }
-    fs::path dir_;
+    cnc_test::ScratchDir scratch_;
+    const fs::path& dir_ = scratch_.path();
 };
 
 TEST(MachineStateFiles, RelativeToTheIniFolderAbsoluteAsGiven) {
@@ -135,11 +120,11 @@ TEST_F(Folder, OnlyWhatChangedIsWritten) {
     EXPECT_FALSE(fs::exists(f.tool_table));
     s.tools.at(1).offset_mm[2] = 30;
     saver.save(s);
-    EXPECT_EQ(read(f.tool_table), "T1 P1 Z30 D6\n");
+    EXPECT_EQ(cnc_test::slurp(f.tool_table), "T1 P1 Z30 D6\n");
     EXPECT_FALSE(fs::exists(f.settings));
     s.offsets.g92[0] = 2.5;
     saver.save(s);
-    const std::string var = read(f.settings);
+    const std::string var = cnc_test::slurp(f.settings);
     EXPECT_NE(var.find("\ng92 2.5 0 0 0 0 0\n"), std::string::npos) << var;
     EXPECT_EQ(var.find("tool"), std::string::npos) << var;
     fs::remove(f.tool_table);
