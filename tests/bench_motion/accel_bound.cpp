@@ -314,6 +314,8 @@ double region_support(const CornerParts& cp, const Vec3& d_any) {
         if (v < best) best = v, best_a = a;
     };
     consider(d);
+    // The region holds the disc of the smaller tolerance about c, so no split can beat that.
+    if (best <= std::min(cp.in->tol_mm, cp.out->tol_mm) * (1 + 1e-12)) return best * len;
     // Both path terms zero for lines: a . u1 = 0 and (d - a) . u2 = 0, a line of a's.
     Vec3 u1 = cp.in->u_end, u2 = cp.out->u_start;
     Vec3 n = cross(u1, u2);
