@@ -8,6 +8,7 @@
 #include <variant>
 
 #include "../machine_state.hpp"
+#include "../probe_result.hpp"
 #include "interp/canon.hpp"
 #include "interp/dialect.hpp"
 #include "interp/executor.hpp"
@@ -145,15 +146,8 @@ void ProgramRunner::adopt_probe_result(const interp::SourceLoc& loc,
                                        const interp::canon::ConditionalMove& cm) {
     if (cfg_.standalone) return;  // the executor's model (g904_trip_mm) stands in
     sync(loc);
-    interp::AxisVec pos{};
-    unsigned axes = 0;
-    for (const auto& w : cm.axes) {
-        if (!w) continue;
-        pos[w->axis] = link_.probe_pos_mm(w->axis);  // the touch, not the stop beyond it
-        axes |= 1u << w->axis;
-    }
-    backend_->executor().adopt_machine_position(pos, axes);
-    if (!link_.probe_tripped()) throw interp::Error(loc, interp::untripped_message(cm, pos));
+    machine_program::adopt_probe_result(backend_->executor(), loc, cm, link_.probe_tripped(),
+                                        [this](int axis) { return link_.probe_pos_mm(axis); });
 }
 
 bool ProgramRunner::deliver() noexcept {
@@ -163,7 +157,7 @@ bool ProgramRunner::deliver() noexcept {
 
 // The end record goes last; done/failed are set before it can reach the consumer, so whoever
 // sees the machine stop after the program's end also sees why.
-void ProgramRunner::finish(const std::string& error) {
+void ProgramRunner::finish(const std::string& error, const interp::Error* located) {
     if (error.empty()) {
         done_.store(true, std::memory_order_release);
     } else {
@@ -174,7 +168,11 @@ void ProgramRunner::finish(const std::string& error) {
         failed_.store(true, std::memory_order_release);
     }
     scratch_.clear();
-    encoder_.end(error, scratch_);
+    if (located)
+        encoder_.end({located->file(), located->line(), located->col()}, located->reason(),
+                     scratch_);
+    else
+        encoder_.end(error, scratch_);
     outbox_.insert(outbox_.end(), scratch_.begin(), scratch_.end());
     finished_ = true;
     running_.store(false, std::memory_order_relaxed);
@@ -194,6 +192,8 @@ void ProgramRunner::run() noexcept {
     if (!interpreter_ && !finished_) {
         try {
             open_program();
+        } catch (const interp::Error& e) {
+            finish(e.what(), &e);
         } catch (const std::exception& e) {
             finish(e.what());
         }
@@ -219,6 +219,8 @@ void ProgramRunner::run() noexcept {
             finish(fmt::format(
                 "{}: {} while waiting for the machine; the rest of the program is given up",
                 where(), abort_.load(std::memory_order_relaxed) ? "aborted" : "stopped"));
+        } catch (const interp::Error& e) {
+            finish(e.what(), &e);
         } catch (const std::exception& e) {
             finish(e.what());
         }

@@ -98,8 +98,8 @@ class ProgramRunner {
     // True when nothing was sent since the last barrier was reached: the machine is current.
     bool machine_current() const noexcept { return current_; }
     // After a conditional move (G904) was sent: waits until the machine has made it, then the
-    // interpreter's model takes the point where it stopped; a move whose inputs never came is
-    // an error at `loc` (NCX-3's alarm).
+    // interpreter's model takes the point where its inputs came; a move whose inputs never
+    // came is an error at `loc` (NCX-3's alarm). See ../probe_result.hpp.
     void adopt_probe_result(const interp::SourceLoc& loc, const interp::canon::ConditionalMove& cm);
 
   private:
@@ -110,7 +110,8 @@ class ProgramRunner {
     void run() noexcept;
     void open_program();
     bool deliver() noexcept;  // outbox -> stream as far as it fits; true when all went
-    void finish(const std::string& error);
+    // `located`, if given, is the error with its place, which the end record carries apart.
+    void finish(const std::string& error, const interp::Error* located = nullptr);
     void mark_ready();
     bool stopping() noexcept;
     std::string where() const;  // "file:line:col" of the last command sent, or the program

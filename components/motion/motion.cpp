@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <cmath>
 #include <fstream>
@@ -167,6 +168,9 @@ class Motion : public hal::Instance {
         cfg.blend_tolerance_mm = blend_tolerance_mm_;
         cfg.machine = sink_config();
         cfg.on_text = [this](const interp::Canon& c) { publish_text(c); };
+        cfg.on_error = [this](const std::optional<interp::SourceLoc>& where,
+                              std::string_view cause) { publish_error(where, cause); };
+        error_published_ = false;  // a new run of the program (after a start that failed)
         feeder_ = std::make_unique<motioncomp::ProgramFeeder>(std::move(cfg), ring_);
         const bool failed_early = feeder_->start_and_wait_ready();
         // An error found before the first servo period is a configuration error: say so now,
@@ -265,6 +269,7 @@ class Motion : public hal::Instance {
                  kins_lost_ || (feeder_ && feeder_->failed());
         if (st.starved) starved_periods_ = ++starved_count_;
         ignored_commands_ = feeder_ ? feeder_->ignored_commands() : 0u;
+        message_dropped_ = dropped_texts_.load(std::memory_order_relaxed);
     }
 
   private:
@@ -276,14 +281,42 @@ class Motion : public hal::Instance {
         return p[0] == '=' ? p.substr(1) : fmt::format("{}.{}", name(), n);
     }
 
-    // The feeder thread (the stream's only producer): M801 messages and warnings go into
-    // motion.messages in the canonical stream's wire form, for `cnc run` or another reader.
-    // A text that does not fit (nobody reads the stream) is dropped whole, so a reader never
-    // sees half a command; motion.message-count still counts the messages reached.
+    // motion.messages, in the canonical stream's wire form, for `cnc run` or another reader:
+    // M801 messages and warnings as commands, and the program's error as an end record with
+    // its place (file, line, column when known) apart from its cause. One producer at a time:
+    // the feeder thread while it runs (texts as they are planned; a planning error when it is
+    // found), the configuration world once it is joined (a fault of the servo function, at
+    // stop or unload). The servo function never writes it.
     void publish_text(const interp::Canon& c) {
+        const std::size_t files = text_encoder_.files_announced();
         text_records_.clear();
         text_encoder_.command(c, text_records_);
-        if (messages_.depth() - messages_.used() < text_records_.size()) return;
+        publish_records(files);
+    }
+
+    // The first error of a run only: the one that stopped the program.
+    void publish_error(const std::optional<interp::SourceLoc>& where, std::string_view cause) {
+        if (error_published_) return;
+        error_published_ = true;
+        const std::size_t files = text_encoder_.files_announced();
+        text_records_.clear();
+        if (where)
+            text_encoder_.end(*where, cause, text_records_);
+        else
+            text_encoder_.end(cause.empty() ? "the program failed" : cause, text_records_);
+        publish_records(files);
+    }
+
+    // A text that does not fit (nobody reads the stream) is dropped whole, so a reader never
+    // sees half of one, and counted on motion.message-dropped (motion.message-count still
+    // counts the messages reached). A file announced only in the dropped records is announced
+    // again by the next text that names it.
+    void publish_records(std::size_t files_before) {
+        if (messages_.depth() - messages_.used() < text_records_.size()) {
+            text_encoder_.forget_files_after(files_before);
+            dropped_texts_.fetch_add(1, std::memory_order_relaxed);
+            return;
+        }
         hal::Value v[interp::wire::kWireFields];
         for (const interp::wire::Record& r : text_records_) {
             for (std::size_t i = 0; i < r.size(); ++i) v[i].u64 = r[i];
@@ -732,18 +765,35 @@ class Motion : public hal::Instance {
     }
 
     // An error met while the program was already running has only the fault pin in realtime;
-    // the text is printed here, in the configuration world, once.
+    // the text is printed here, in the configuration world, once. A servo function's fault goes
+    // to motion.messages from here too (the feeder thread, its other producer, is joined by
+    // now); the feeder thread sent its own error when it met it.
     void report_late_error() {
         if (!fault_reported_ && report_.cause != FaultCause::None) {
             fault_reported_ = true;
-            fmt::print(stderr, "{}: {}\n", name(), fault_text(report_));
+            const std::string cause = fault_cause(report_);
+            if (names_line(report_.cause)) {
+                const std::string file = feeder_ ? feeder_->program_file() : program_path_;
+                fmt::print(stderr, "{}: {}:{}: {}\n", name(), file, report_.line, cause);
+                publish_error(interp::SourceLoc{file, report_.line, 0}, cause);
+            } else {
+                fmt::print(stderr, "{}: {}\n", name(), cause);
+                publish_error(std::nullopt, cause);
+            }
         }
         if (error_reported_ || !feeder_ || !feeder_->failed()) return;
         error_reported_ = true;
         fmt::print(stderr, "{}: {}\n", name(), feeder_->error());
     }
 
-    std::string fault_text(const FaultReport& r) const {
+    // Faults of a program action or move, at its line (FaultReport::line).
+    static bool names_line(FaultCause c) {
+        return c == FaultCause::WaitTimeout || c == FaultCause::ToolOffsetJump ||
+               c == FaultCause::JointSoftLimit;
+    }
+
+    // Why, without the place (names_line() tells whether the fault has one).
+    std::string fault_cause(const FaultReport& r) const {
         switch (r.cause) {
             case FaultCause::EStop:
                 return fmt::format("e-stop: {} went FALSE; motion stopped, program abandoned",
@@ -757,27 +807,24 @@ class Motion : public hal::Instance {
                     pin_name(fmt::format("joint.{}.{}-lim-sw-in", r.joint, pos ? "pos" : "neg")));
             }
             case FaultCause::WaitTimeout:
-                return fmt::format("{}:{}: G906: {} did not become {} within {} s",
-                                   feeder_ ? feeder_->program_file() : program_path_, r.line,
+                return fmt::format("G906: {} did not become {} within {} s",
                                    pin_name(fmt::format("motion.digital-in-{:02}", r.action.value)),
                                    r.action.flag ? "TRUE" : "FALSE", r.action.number);
             case FaultCause::ToolOffsetJump:
                 return fmt::format(
-                    "{}:{}: the tool length offset changes to {} mm while the kinematics use it: "
-                    "joint {} would jump {:.4f} mm (the table is tilted); change the tool offset "
-                    "(G43/G49, and M30's reset) with the rotary axes at 0; motion stopped, "
-                    "program abandoned",
-                    feeder_ ? feeder_->program_file() : program_path_, r.line, r.action.number,
-                    r.joint, r.amount);
+                    "the tool length offset changes to {} mm while the kinematics use it: joint {} "
+                    "would jump {:.4f} mm (the table is tilted); change the tool offset (G43/G49, "
+                    "and M30's reset) with the rotary axes at 0; motion stopped, program "
+                    "abandoned",
+                    r.action.number, r.joint, r.amount);
             case FaultCause::JointSoftLimit: {
                 // A joint that drives A, B or C turns (degrees).
                 const int axis = kins_.kins().joint_axes()[static_cast<std::size_t>(r.joint)];
                 const char* unit = axis >= 3 && axis <= 5 ? "deg" : "mm";
                 return fmt::format(
-                    "{}:{}: joint {} commanded to {:.4f} {}, beyond its soft limit [{:g}, {:g}] {} "
-                    "({}); motion stopped, program abandoned",
-                    feeder_ ? feeder_->program_file() : program_path_, r.line, r.joint, r.amount,
-                    unit, r.min_mm, r.max_mm, unit,
+                    "joint {} commanded to {:.4f} {}, beyond its soft limit [{:g}, {:g}] {} ({}); "
+                    "motion stopped, program abandoned",
+                    r.joint, r.amount, unit, r.min_mm, r.max_mm, unit,
                     pin_name(fmt::format("joint.{}.{}-limit", r.joint,
                                          r.amount > r.max_mm ? "max" : "min")));
             }
@@ -1068,6 +1115,8 @@ class Motion : public hal::Instance {
     hal::Out<double> probe_pos_y_{this, pin("motion.probe-pos-y")};
     hal::Out<double> probe_pos_z_{this, pin("motion.probe-pos-z")};
     hal::Out<std::uint32_t> message_count_{this, pin("motion.message-count")};
+    // Texts (messages, warnings, the error) motion.messages had no room for: nobody reads it.
+    hal::Out<std::uint32_t> message_dropped_{this, pin("motion.message-dropped")};
     hal::Out<bool> limits_masked_pin_{this, pin("motion.limits-masked")};
     hal::Out<bool> spindle_clamp_{this, pin("spindle.0.clamp")};
     hal::Param<double> blend_tolerance_mm_{this, pin("motion.blend-tolerance"), 0.01};
@@ -1077,8 +1126,11 @@ class Motion : public hal::Instance {
     std::unique_ptr<motioncomp::ProgramFeeder> feeder_;
     std::optional<hal::Stream> canon_;                // canon=: the interp component's stream
     hal::Stream messages_;                            // motion.messages: M801 texts and warnings
-    interp::wire::Encoder text_encoder_;              // feeder thread only
-    std::vector<interp::wire::Record> text_records_;  // feeder thread only
+    // motion.messages' producer only (see publish_text).
+    interp::wire::Encoder text_encoder_;
+    std::vector<interp::wire::Record> text_records_;
+    bool error_published_ = false;
+    std::atomic<std::uint32_t> dropped_texts_{0};  // the producer adds, the servo function reads
     motion::AxisArray home_shift_mm_{};  // machine coordinate minus planner frame (M902)
     bool limits_masked_ = false;         // M802 P131072 until P131073
     hal::Out<std::uint32_t> canon_sync_{this, pin("motion.canon-sync")};

@@ -226,10 +226,10 @@ class Sink final : public PlanSink {
     void handle(const interp::SourceLoc& loc, const interp::canon::HomeDone& h) {
         const int axis = h.axis;  // 0..3 = X Y Z A, the planner's first four axes
         if (axis < 0 || axis >= motion::kAxes || !cfg_.axis_present[axis])
-            throw std::runtime_error(fmt::format(
-                "{}:{}:{}: M902: axis {} is not on this machine (coordinates={})", loc.file,
-                loc.line, loc.col, axis >= 0 && axis < motion::kAxes ? kAxisLetters[axis] : '?',
-                cfg_.coordinates));
+            throw interp::Error(
+                loc, fmt::format("M902: axis {} is not on this machine (coordinates={})",
+                                 axis >= 0 && axis < motion::kAxes ? kAxisLetters[axis] : '?',
+                                 cfg_.coordinates));
         shift_mm_[axis] = h.position_mm - pos_mm_[axis];
         queue(loc, {motion::ActionKind::HomeDone, false, axis, shift_mm_[axis]});
     }
@@ -250,10 +250,9 @@ class Sink final : public PlanSink {
             check_port(loc, "G904", "input", "digital-in", w->port, cfg_.machine.digital_inputs);
             const int axis = k;  // the interpreter's X Y Z are the planner's first three axes
             if (!cfg_.axis_present[axis])
-                throw std::runtime_error(
-                    fmt::format("{}:{}:{}: G904: axis {} moves but the machine has only "
-                                "coordinates={}",
-                                loc.file, loc.line, loc.col, kAxisLetters[axis], cfg_.coordinates));
+                throw interp::Error(
+                    loc, fmt::format("G904: axis {} moves but the machine has only coordinates={}",
+                                     kAxisLetters[axis], cfg_.coordinates));
             motion::ProbeAxis& p = rec.probe[axis];
             p.input = w->port;
             p.level = w->level;
@@ -310,9 +309,9 @@ class Sink final : public PlanSink {
         seg.move_id = ++next_move_id_;
         for (int k = 0; k < motion::kAxes; ++k) {
             if (!cfg_.axis_present[k] && std::fabs(seg.end_mm[k] - pos_mm_[k]) > 1e-9)
-                throw std::runtime_error(
-                    fmt::format("{}:{}:{}: axis {} moves but the machine has only coordinates={}",
-                                loc.file, loc.line, loc.col, kAxisLetters[k], cfg_.coordinates));
+                throw interp::Error(
+                    loc, fmt::format("axis {} moves but the machine has only coordinates={}",
+                                     kAxisLetters[k], cfg_.coordinates));
         }
         return seg;
     }
@@ -336,19 +335,19 @@ class Sink final : public PlanSink {
     }
 
     [[noreturn]] static void refuse_latch(const interp::SourceLoc& loc, const char* code) {
-        throw std::runtime_error(fmt::format(
-            "{}:{}:{}: {}: encoder latches are not supported on this machine (the motion "
-            "component has no latch input from its drives)",
-            loc.file, loc.line, loc.col, code));
+        throw interp::Error(
+            loc, fmt::format("{}: encoder latches are not supported on this machine (the motion "
+                             "component has no latch input from its drives)",
+                             code));
     }
 
     static void check_port(const interp::SourceLoc& loc, const char* code, const char* what,
                            const char* pin, int port, int count) {
         if (port >= 0 && port < count) return;
-        throw std::runtime_error(
-            fmt::format("{}:{}:{}: {}: {} {} does not exist: the machine has motion.{}-00 to {:02} "
-                        "(num_dio={})",
-                        loc.file, loc.line, loc.col, code, what, port, pin, count - 1, count));
+        throw interp::Error(
+            loc, fmt::format("{}: {} {} does not exist: the machine has motion.{}-00 to {:02} "
+                             "(num_dio={})",
+                             code, what, port, pin, count - 1, count));
     }
 
     // LinuxCNC refuses a move whose path leaves the soft limits before it starts; so does this.
@@ -362,10 +361,11 @@ class Sink final : public PlanSink {
             const double hi = cfg_.machine.max_limit_mm[k] - shift_mm_[k];
             const bool low = reach.lo_mm[k] < lo - kSlack_mm;
             if (!low && reach.hi_mm[k] <= hi + kSlack_mm) continue;
-            throw std::runtime_error(
-                fmt::format("{}:{}:{}: the move takes {} to {} mm, which exceeds the soft limit "
+            throw interp::Error(
+                loc,
+                fmt::format("the move takes {} to {} mm, which exceeds the soft limit "
                             "axis.{}.{}-limit = {} mm",
-                            loc.file, loc.line, loc.col, kAxisLetters[k],
+                            kAxisLetters[k],
                             interp::fmt_num((low ? reach.lo_mm[k] : reach.hi_mm[k]) + shift_mm_[k]),
                             kLowerAxes[k], low ? "min" : "max",
                             interp::fmt_num((low ? lo : hi) + shift_mm_[k])));
@@ -393,13 +393,15 @@ class Sink final : public PlanSink {
             if (cfg_.axis_present[k])
                 where += fmt::format("{}{}{}", where.empty() ? "" : " ", kAxisLetters[k],
                                      interp::fmt_num(at[k]));
-        throw std::runtime_error(fmt::format(
-            "{}:{}:{}: joint {} would move to {} {} (axis position {}), beyond its soft limit "
-            "[{:g}, {:g}] {} ({}.{}.{}-limit); the move is refused before it starts",
-            loc.file, loc.line, loc.col, v->joint,
-            position_text(v->position, v->above ? jc.max_limit[joint] : jc.min_limit[joint]), unit,
-            where, jc.min_limit[joint], jc.max_limit[joint], unit, jc.pin_stem, v->joint,
-            v->above ? "max" : "min"));
+        throw interp::Error(
+            loc,
+            fmt::format(
+                "joint {} would move to {} {} (axis position {}), beyond its soft limit "
+                "[{:g}, {:g}] {} ({}.{}.{}-limit); the move is refused before it starts",
+                v->joint,
+                position_text(v->position, v->above ? jc.max_limit[joint] : jc.min_limit[joint]),
+                unit, where, jc.min_limit[joint], jc.max_limit[joint], unit, jc.pin_stem, v->joint,
+                v->above ? "max" : "min"));
     }
 
     // Four decimals, or as many as it takes to show the position beyond `limit`.
@@ -417,7 +419,7 @@ class Sink final : public PlanSink {
         std::string reason = e.what();
         const auto colon = reason.find(": ");
         if (colon != std::string::npos) reason.erase(0, colon + 2);
-        throw std::runtime_error(fmt::format("{}:{}:{}: {}", loc.file, loc.line, loc.col, reason));
+        throw interp::Error(loc, reason);
     }
 
     void push(const interp::SourceLoc& loc, const motion::PathSegment& seg) {

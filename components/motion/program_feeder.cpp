@@ -1,7 +1,5 @@
 #include "program_feeder.hpp"
 
-#include <fmt/format.h>
-
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -12,6 +10,7 @@
 #include <variant>
 
 #include "../machine_state.hpp"
+#include "../probe_result.hpp"
 #include "interp/canon.hpp"
 #include "interp/canon_wire.hpp"
 #include "interp/dialect.hpp"
@@ -76,7 +75,8 @@ void ProgramFeeder::await_probe(const interp::SourceLoc& loc,
                                 const interp::canon::ConditionalMove& cm) {
     probe_pending_ = true;
     probe_cmd_ = cm;
-    probe_where_ = fmt::format("{}:{}:{}", loc.file, loc.line, loc.col);
+    probe_file_ = loc.file;
+    probe_loc_ = interp::SourceLoc{probe_file_, loc.line, loc.col};
 }
 
 void ProgramFeeder::report_probe(const motion::AxisArray& pos_mm, const motion::AxisArray& trip_mm,
@@ -93,26 +93,19 @@ bool ProgramFeeder::probe_result_waiting() const noexcept {
 }
 
 // The path goes on from where the conditional move stopped. With the interpreter in-process
-// its model takes the point where the inputs came (the trip point; the machine stands a
-// braking distance beyond it, which #CURMACHPOS reads: StandingMachine), so an incremental
-// move after the G904 is measured from the touch, and a move that ended without its inputs is
-// the alarm NCX-3 asks for; with the interp component, that component does both (it waits at
-// the barrier it sends after a G904 and reads motion.probe-pos-L and motion.probe-tripped).
+// its model takes the point where the inputs came (machine_program::adopt_probe_result; the
+// machine stands a braking distance beyond it, which #CURMACHPOS reads: StandingMachine), and a
+// move that ended without its inputs throws the alarm NCX-3 asks for; with the interp
+// component, that component does both (it waits at the barrier it sends after a G904 and reads
+// motion.probe-pos-L and motion.probe-tripped).
 void ProgramFeeder::take_probe_result() {
     probe_pending_ = false;
     sink_->restart_from(probe_pos_mm_);
     if (!executor_) return;
     const motion::AxisArray machine_mm = sink_->to_machine(probe_trip_mm_);
-    interp::AxisVec pos{};
-    unsigned axes = 0;
-    for (const auto& w : probe_cmd_.axes) {
-        if (!w) continue;
-        pos[w->axis] = machine_mm[w->axis];
-        axes |= 1u << w->axis;
-    }
-    executor_->executor().adopt_machine_position(pos, axes);
-    if (!probe_tripped_)
-        fail(fmt::format("{}: {}", probe_where_, interp::untripped_message(probe_cmd_, pos)));
+    machine_program::adopt_probe_result(
+        executor_->executor(), probe_loc_, probe_cmd_, probe_tripped_,
+        [&machine_mm](int axis) { return machine_mm[static_cast<std::size_t>(axis)]; });
 }
 
 void ProgramFeeder::wait_for_lead() const noexcept {
@@ -232,12 +225,21 @@ void ProgramFeeder::deliver() noexcept {
     while (!outbox_.empty() && ring_.try_push(outbox_.front())) outbox_.pop_front();
 }
 
-void ProgramFeeder::fail(const std::string& message) {
+void ProgramFeeder::fail(const std::exception& e) {
     {
         std::lock_guard lock(mutex_);
-        error_ = message;
+        error_ = e.what();
     }
     failed_.store(true, std::memory_order_release);
+    if (cfg_.on_error) {
+        // interp::Error (the interpreter's, the sink's refusals, the stream's end record with
+        // a place) keeps its place apart from its cause; anything else has none.
+        if (const auto* located = dynamic_cast<const interp::Error*>(&e))
+            cfg_.on_error(interp::SourceLoc{located->file(), located->line(), located->col()},
+                          located->reason());
+        else
+            cfg_.on_error(std::nullopt, e.what());
+    }
     // Motion already planned stays valid: it runs out to rest.
     planner_->finish();
     collect_at_rest(planner_->end_position(), nullptr);
@@ -268,7 +270,7 @@ void ProgramFeeder::run() noexcept {
         } catch (const std::exception& e) {
             if (!planner_)
                 planner_ = std::make_unique<motion::Planner>(cfg_.plan, motion::AxisArray{});
-            fail(e.what());
+            fail(e);
         }
     }
     while (!stopping()) {
@@ -289,7 +291,11 @@ void ProgramFeeder::run() noexcept {
                 continue;
             }
             probe_announced_ = false;
-            take_probe_result();
+            try {
+                take_probe_result();
+            } catch (const std::exception& e) {
+                fail(e);
+            }
             continue;
         }
         if (program_done_ || outbox_.size() >= kOutboxLimit || barrier_pending_) {
@@ -310,7 +316,7 @@ void ProgramFeeder::run() noexcept {
                     break;
             }
         } catch (const std::exception& e) {
-            fail(e.what());
+            fail(e);
         }
     }
     if ((program_done_ && outbox_.empty()) || abandoned_.load(std::memory_order_relaxed))
@@ -332,8 +338,10 @@ ProgramFeeder::Progress ProgramFeeder::read_stream() {
             case interp::wire::Decoder::Item::None:
                 continue;
             case interp::wire::Decoder::Item::End:
-                if (decoder_->failed()) throw std::runtime_error(decoder_->error());
-                return Progress::End;
+                if (!decoder_->failed()) return Progress::End;
+                if (const auto& where = decoder_->error_loc())
+                    throw interp::Error(*where, decoder_->error_cause());
+                throw std::runtime_error(decoder_->error());
             case interp::wire::Decoder::Item::Command: {
                 const interp::Canon& c = decoder_->command();
                 if (!stream_file_known_) remember_stream_file(c.loc.file);

@@ -15,9 +15,11 @@
 #include <atomic>
 #include <cstdint>
 #include <deque>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -57,6 +59,10 @@ struct FeederConfig {
     // are planned, on the feeder thread. The n-th Message is message n of
     // PreparedSegment::message, shown when the machine reaches it.
     std::function<void(const interp::Canon&)> on_text;
+    // The program's error, on the feeder thread, when planning fails (what was planned still
+    // runs out): where (nullopt when no place is known; the file view lives as long as the
+    // call) and the cause, without the place. error() has the whole text.
+    std::function<void(const std::optional<interp::SourceLoc>&, std::string_view cause)> on_error;
 };
 
 class ProgramFeeder {
@@ -133,7 +139,7 @@ class ProgramFeeder {
     void take_probe_result();
     bool stopping() const noexcept;
     void deliver() noexcept;  // outbox -> ring, as far as it fits
-    void fail(const std::string& message);
+    void fail(const std::exception& e);
     void mark_ready();
     void remember_stream_file(std::string_view file);
 
@@ -180,7 +186,8 @@ class ProgramFeeder {
     bool probe_pending_ = false;    // feeder thread
     bool probe_announced_ = false;  // counted in probes_sent_
     interp::canon::ConditionalMove probe_cmd_;
-    std::string probe_where_;  // "file:line:col" of the G904
+    std::string probe_file_;       // of the G904
+    interp::SourceLoc probe_loc_;  // of the G904, its file viewing probe_file_
     std::atomic<std::uint32_t> probes_sent_{0};
     std::atomic<std::uint32_t> probes_done_{0};
     motion::AxisArray probe_pos_mm_{};

@@ -109,11 +109,13 @@ TEST(CncRunIo, G904WithoutItsInputIsAnErrorAtItsLine) {
         run_cnc(fmt::format("'{}' '{}' --sim-clock", ini.string(), prog.string()), scratch.path());
     EXPECT_EQ(r.exit_code, 1);
     // why: 2 mm of maximum travel from Z-5 lands exactly on -7; the G904 is at column 3.
-    EXPECT_NE(r.err.find(prog.string() +
-                         ":3:3: G904: Z stopped at -7 mm with input 3 not at level 1 (the "
-                         "maximum travel or a soft limit came first)"),
-              std::string::npos)
-        << r.err;
+    const std::string error = prog.string() +
+                              ":3:3: G904: Z stopped at -7 mm with input 3 not at level 1 (the "
+                              "maximum travel or a soft limit came first)";
+    EXPECT_NE(r.err.find(error), std::string::npos) << r.err;
+    // The summary names it too: the interp component's error reaches motion, and motion's
+    // `cnc run`, with its place apart from its cause (not "line 3: motion fault").
+    EXPECT_EQ(cnc_test::summary_field(r.out, "errors"), error) << r.out;
     const std::vector<double> pos = final_position(r.out);
     ASSERT_EQ(pos.size(), 3u) << r.out;
     EXPECT_NEAR(pos[2], -7, 1e-9);  // line 4 never ran

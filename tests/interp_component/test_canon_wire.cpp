@@ -204,6 +204,50 @@ TEST(CanonWire, EndRecordCarriesTheErrorText) {
     EXPECT_EQ(item, wire::Decoder::Item::End);
     EXPECT_TRUE(dec.failed());
     EXPECT_EQ(dec.error(), error);
+    EXPECT_FALSE(dec.error_loc());  // a text only: no place apart from it
+    EXPECT_EQ(dec.error_cause(), error);
+}
+
+TEST(CanonWire, EndRecordCarriesThePlaceApartFromTheCause) {
+    wire::Encoder enc;
+    std::vector<wire::Record> records;
+    enc.end(SourceLoc{"part.ngc", 3, 8}, "expected a number or '=' after Q", records);
+    ASSERT_EQ(records.size(), 4u);  // file, its name, end, its text
+    wire::Decoder dec;
+    wire::Decoder::Item item = wire::Decoder::Item::None;
+    for (const auto& r : records) item = dec.feed(r);
+    EXPECT_EQ(item, wire::Decoder::Item::End);
+    EXPECT_TRUE(dec.failed());
+    EXPECT_EQ(dec.error(), "part.ngc:3:8: expected a number or '=' after Q");
+    ASSERT_TRUE(dec.error_loc());
+    EXPECT_EQ(dec.error_loc()->file, "part.ngc");
+    EXPECT_EQ(dec.error_loc()->line, 3);
+    EXPECT_EQ(dec.error_loc()->col, 8);
+    EXPECT_EQ(dec.error_cause(), "expected a number or '=' after Q");
+    wire::Decoder unannounced;  // the end record without the file record before it
+    EXPECT_THROW(unannounced.feed(records[2]), wire::Error);
+}
+
+// A producer that drops a command it has no room for (motion.messages nobody reads) forgets the
+// files announced only with it; the next command naming such a file announces it again.
+TEST(CanonWire, AFileAnnouncedOnlyInDroppedRecordsIsAnnouncedAgain) {
+    wire::Encoder enc;
+    std::vector<wire::Record> delivered, dropped;
+    enc.command(Canon{SourceLoc{"main.ngc", 1, 1}, canon::Message{"one"}}, delivered);
+    const std::size_t files = enc.files_announced();
+    EXPECT_EQ(files, 1u);
+    enc.command(Canon{SourceLoc{"sub.ngc", 2, 1}, canon::Message{"two"}}, dropped);
+    enc.forget_files_after(files);
+    enc.command(Canon{SourceLoc{"sub.ngc", 3, 1}, canon::Message{"three"}}, delivered);
+    wire::Decoder dec;
+    std::vector<Canon> out;
+    for (const auto& r : delivered)
+        if (dec.feed(r) == wire::Decoder::Item::Command) out.push_back(dec.command());
+    ASSERT_EQ(out.size(), 2u);
+    EXPECT_EQ(out[1].loc.file, "sub.ngc");
+    EXPECT_EQ(out[1].loc.line, 3);
+    ASSERT_TRUE(std::holds_alternative<canon::Message>(out[1].cmd));
+    EXPECT_EQ(std::get<canon::Message>(out[1].cmd).text, "three");
 }
 
 TEST(CanonWire, MalformedSequencesAreRefused) {

@@ -393,10 +393,19 @@ class Progress {
     double next_plain_s_ = 1.0;
 };
 
+// The program's error as motion tells it on motion.messages: the place ("file:line", or
+// "file:line:col" when the column is known; empty for a fault that names no line, such as a
+// limit switch) and the cause.
+struct ProgramError {
+    std::string place;
+    std::string cause;
+};
+
 // The program's M801 messages and warnings, from motion's stream motion.messages (the canonical
 // stream's wire form): a warning is printed when it arrives, the n-th message when
 // motion.message-count reaches n (the machine has got there), each on a line of its own; on a
-// terminal the progress bar is cleared first and redrawn by its next update.
+// terminal the progress bar is cleared first and redrawn by its next update. The stream's end
+// record, if motion sends one, is the program's error, kept for the summary.
 class OperatorTexts {
   public:
     OperatorTexts(hal::Runtime& rt, bool tty)
@@ -409,6 +418,9 @@ class OperatorTexts {
         if (ring_->fields != interp::wire::kWireFields) ring_ = nullptr;
         record_.resize(interp::wire::kWireFields);
     }
+
+    // The first error motion sent, if any (poll() first).
+    const std::optional<ProgramError>& error() const { return error_; }
 
     void poll() {
         if (!ring_) return;
@@ -427,7 +439,14 @@ class OperatorTexts {
     void take() {
         interp::wire::Record r;
         for (std::size_t i = 0; i < r.size(); ++i) r[i] = record_[i].u64;
-        if (decoder_.feed(r) != interp::wire::Decoder::Item::Command) return;
+        const interp::wire::Decoder::Item item = decoder_.feed(r);
+        if (item == interp::wire::Decoder::Item::End && decoder_.failed() && !error_) {
+            error_ = ProgramError{"", decoder_.error_cause()};
+            if (const auto& at = decoder_.error_loc())
+                error_->place = at->col > 0 ? fmt::format("{}:{}:{}", at->file, at->line, at->col)
+                                            : fmt::format("{}:{}", at->file, at->line);
+        }
+        if (item != interp::wire::Decoder::Item::Command) return;
         const interp::Canon& c = decoder_.command();
         if (const auto* m = std::get_if<interp::canon::Message>(&c.cmd)) {
             messages_.push_back(fmt::format("{}:{}: message: {}", c.loc.file, c.loc.line,
@@ -451,6 +470,7 @@ class OperatorTexts {
     interp::wire::Decoder decoder_;
     std::deque<std::string> messages_;  // decoded, not yet reached
     double shown_ = 0;
+    std::optional<ProgramError> error_;
 };
 
 // The trace: a header row, then one row per sample: t, line, axis commands, joint feedback,
@@ -498,6 +518,9 @@ std::string drive_fault_text(const MachinePins& p) {
     return "";
 }
 
+// Drive faults and following errors, which motion tells only by pins; "" for any other fault
+// (a refused line, a limit switch, a G906 timeout, ...), whose cause motion sends on
+// motion.messages (OperatorTexts::error) and prints on stderr.
 std::string describe_fault(const MachinePins& p, const Sample& s) {
     if (std::string drive = drive_fault_text(p); !drive.empty()) return drive;
     for (std::size_t j = 0; j < p.ferror.size(); ++j) {
@@ -505,9 +528,7 @@ std::string describe_fault(const MachinePins& p, const Sample& s) {
             return fmt::format("following error on joint {}: {:.4f} mm, over its limit {} mm", j,
                                s.ferror_mm[j], p.ferror_limit[j].number());
     }
-    // Limit switches, joint soft limits, kinematics faults: motion prints the cause itself
-    // (`motion.0: file:line: ...` on stderr, at the stop).
-    return "motion fault (the cause is in motion's message on stderr)";
+    return "";
 }
 
 // The instance this process owns, torn down on every path out.
@@ -845,14 +866,29 @@ std::function<void(Sample&)> make_source(Session& session, const MachinePins& pi
     };
 }
 
+// A fault's error line. A drive fault or following error names the line running when it came;
+// motion's own error names the line it is about (a move refused after the machine started
+// names the refused line, not the one running) or, for one without a place (a limit switch),
+// the line running.
+std::string fault_error(const RunOptions& o, const LoopResult& r,
+                        const std::optional<ProgramError>& motion_error) {
+    const std::string running = fmt::format("{}:{}", o.program, r.fault_line);
+    if (!r.fault_text.empty()) return fmt::format("{}: {}", running, r.fault_text);
+    if (motion_error)
+        return fmt::format("{}: {}", motion_error->place.empty() ? running : motion_error->place,
+                           motion_error->cause);
+    return fmt::format("{}: motion fault (the cause is in motion's message on stderr)", running);
+}
+
 // The error line for an outcome other than Finished: `PROGRAM:LINE: what`.
-std::string outcome_error(const RunOptions& o, const LoopResult& r) {
+std::string outcome_error(const RunOptions& o, const LoopResult& r,
+                          const std::optional<ProgramError>& motion_error) {
     const std::string where = fmt::format("{}:{}", o.program, r.last.line);
     switch (r.outcome) {
         case Outcome::Finished:
             return "";
         case Outcome::Fault:
-            return fmt::format("{}:{}: {}", o.program, r.fault_line, r.fault_text);
+            return fault_error(o, r, motion_error);
         case Outcome::Disabled:
             return fmt::format(
                 "{}: the machine was disabled during the program (e-stop: motion.enable went "
@@ -929,11 +965,12 @@ int run_session(const RunOptions& o, const Config& c, Session& session, const St
         watch(session, pins, o, make_source(session, pins, o, c.period_s, stream.get()), stats,
               progress, texts, trace.get(), preview.get(), stop);
     progress.finish(r.last.t_s, r.outcome == Outcome::Finished);
-    session.exec({"stop"});  // motion prints a late planner error here
+    session.exec({"stop"});  // motion prints a late error here (and sends a servo fault's)
+    texts.poll();
     if (stream && stream->lost_cycles() > 0)
         fmt::print(stderr, "warning: {} servo cycles were not sampled (this process fell behind)\n",
                    stream->lost_cycles());
-    const std::string error = outcome_error(o, r);
+    const std::string error = outcome_error(o, r, texts.error());
     print_summary(o, c, pins, r, stats, error);
     if (preview) {
         try {

@@ -8,7 +8,9 @@
 //   word 0   type (bits 0-7) | command index (bits 8-23) | continuation records (bits 24-55)
 //   command  word 1 = line | col << 32, word 2 = file id, words 3.. = the command's fields
 //   file     word 1 = file id, name in continuations
-//   end      word 1 = 1 if failed, error text in continuations
+//   end      word 1 = 1 if failed; words 2 and 3 = where it failed, if the producer knows:
+//            word 2 = line | col << 32, word 3 = file id + 1 (0: no place, words 2 and 3
+//            unused); the error in continuations (the cause alone when a place is given)
 //   continuation  words 1.. = text bytes
 //
 // The fields of each command are listed once, in canon_wire.cpp (`fields(archive, command)`),
@@ -18,6 +20,7 @@
 #include <array>
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -50,6 +53,15 @@ class Encoder {
     void command(const Canon& c, std::vector<Record>& out);
     // Appends the end record: `error` empty for a program that completed.
     void end(std::string_view error, std::vector<Record>& out);
+    // Appends the end record of a program that failed at `where` because of `cause` (a file
+    // record first if the file is new).
+    void end(const SourceLoc& where, std::string_view cause, std::vector<Record>& out);
+
+    // Files announced so far. A producer that drops records it could not deliver (a full
+    // stream) passes the count from before them to forget_files_after(), so that the next
+    // command naming a file announced only in the dropped records announces it again.
+    std::size_t files_announced() const { return files_.size(); }
+    void forget_files_after(std::size_t count);
 
   private:
     std::uint32_t file_id(std::string_view file, std::vector<Record>& out);
@@ -65,8 +77,12 @@ class Decoder {
     // number in the stream (1 = the first fed to this decoder).
     Item feed(const Record& r);
     const Canon& command() const { return command_; }
+    // After End: failed() and the error, whole ("file:line:col: cause" when the producer gave
+    // a place), or as its place (its file stays valid while the decoder lives) and its cause.
     bool failed() const { return failed_; }
     const std::string& error() const { return text_; }
+    const std::optional<SourceLoc>& error_loc() const { return error_loc_; }
+    const std::string& error_cause() const { return cause_; }
 
   private:
     Item take(const Record& r);
@@ -78,6 +94,8 @@ class Decoder {
     std::deque<std::string> files_;  // by id; a deque keeps the strings in place
     Canon command_;
     bool failed_ = false;
+    std::optional<SourceLoc> error_loc_;
+    std::string cause_;
 };
 
 }  // namespace interp::wire

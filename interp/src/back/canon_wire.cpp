@@ -310,6 +310,14 @@ std::uint32_t continuations_of(const Record& r) {
     return static_cast<std::uint32_t>((r[0] >> 24) & 0xffffffff);
 }
 
+std::uint64_t location_word(const SourceLoc& loc) {
+    return static_cast<std::uint32_t>(loc.line) |
+           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(loc.col)) << 32);
+}
+SourceLoc location_of(std::uint64_t word, std::string_view file) {
+    return SourceLoc{file, static_cast<int>(word & 0xffffffff), static_cast<int>(word >> 32)};
+}
+
 // Appends `first` and the continuation records carrying `text`.
 void append_with_text(Record first, std::string_view text, std::vector<Record>& out) {
     const std::size_t count = (text.size() + kTextBytesPerRecord - 1) / kTextBytesPerRecord;
@@ -384,8 +392,7 @@ void Encoder::command(const Canon& c, std::vector<Record>& out) {
     const std::uint32_t file = file_id(c.loc.file, out);
     Record r{};
     r[0] = header(Type::Command, c.cmd.index(), 0);
-    r[1] = static_cast<std::uint32_t>(c.loc.line) |
-           (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.loc.col)) << 32);
+    r[1] = location_word(c.loc);
     r[2] = file;
     std::string text;
     const std::string what = name_of(c.cmd);
@@ -408,6 +415,20 @@ void Encoder::end(std::string_view error, std::vector<Record>& out) {
     r[0] = header(Type::End, 0, 0);
     r[1] = error.empty() ? 0 : 1;
     append_with_text(r, error, out);
+}
+
+void Encoder::end(const SourceLoc& where, std::string_view cause, std::vector<Record>& out) {
+    const std::uint32_t file = file_id(where.file, out);
+    Record r{};
+    r[0] = header(Type::End, 0, 0);
+    r[1] = 1;
+    r[2] = location_word(where);
+    r[3] = std::uint64_t{file} + 1;
+    append_with_text(r, cause, out);
+}
+
+void Encoder::forget_files_after(std::size_t count) {
+    std::erase_if(files_, [count](const auto& f) { return f.second >= count; });
 }
 
 Decoder::Item Decoder::feed(const Record& r) {
@@ -435,6 +456,8 @@ Decoder::Item Decoder::take(const Record& r) {
         throw Error(fmt::format("unknown record type {}", static_cast<int>(t)));
     if (t == Type::Command && r[2] >= files_.size())
         throw Error(fmt::format("command names file id {}, never announced", r[2]));
+    if (t == Type::End && r[3] > files_.size())
+        throw Error(fmt::format("end record names file id {}, never announced", r[3] - 1));
     first_ = r;
     text_.clear();
     continuations_left_ = continuations_of(r);
@@ -456,14 +479,20 @@ Decoder::Item Decoder::complete() {
         case Type::End:
             failed_ = first_[1] != 0;
             text_.erase(std::min(text_.find('\0'), text_.size()));
+            cause_ = text_;
+            error_loc_.reset();
+            if (first_[3] != 0) {
+                error_loc_ = location_of(first_[2], files_[first_[3] - 1]);
+                text_ = fmt::format("{}:{}:{}: {}", error_loc_->file, error_loc_->line,
+                                    error_loc_->col, cause_);
+            }
             return Item::End;
         default:
             break;
     }
     const std::size_t index = index_of(first_);
     const std::uint64_t file = first_[2];
-    command_.loc = SourceLoc{files_[file], static_cast<int>(first_[1] & 0xffffffff),
-                             static_cast<int>(first_[1] >> 32)};
+    command_.loc = location_of(first_[1], files_[file]);
     if (index >= std::variant_size_v<CanonCommand> ||
         !decode_command(index, first_, text_, command_.cmd,
                         std::make_index_sequence<std::variant_size_v<CanonCommand>>{}))
