@@ -10,11 +10,13 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 #include "interp/block.hpp"
 #include "interp/executor.hpp"
@@ -63,7 +65,9 @@ inline interp::Settings load_state(const StateFiles& files) {
 }
 
 // Writes the parts of the settings that changed since the last write (or the load): the tool
-// table when it is kept, the rest into the settings file (the tools too when no tool table is).
+// table when it is kept (edited in place, so a hand-written table keeps its other words, comments
+// and order: interp::update_linuxcnc_tool_table), the rest into the settings file (the tools too
+// when no tool table is).
 class StateSaver {
   public:
     StateSaver(StateFiles files, interp::Settings loaded)
@@ -74,7 +78,7 @@ class StateSaver {
     void save(const interp::Settings& s) {
         const bool table = !files_.tool_table.empty();
         if (table && !(s.tools == saved_.tools)) {
-            interp::save_tool_table_atomic(files_.tool_table, s.tools);
+            interp::save_tool_table_atomic(files_.tool_table, s.tools, files_.tool_table_seed);
             saved_.tools = s.tools;
         }
         if (files_.settings.empty()) return;
@@ -100,14 +104,29 @@ class StateSaver {
     interp::Settings saved_;  // what the files hold now
 };
 
+// The locks on a machine's settings file and tool table (interp::SettingsFileLock), held by
+// whoever may save them for as long as it may. Throws std::runtime_error naming the file (and
+// the holder's process id) when another run holds one.
+class StateLocks {
+  public:
+    explicit StateLocks(const StateFiles& files) {
+        for (const std::string* path : {&files.settings, &files.tool_table})
+            if (!path->empty()) locks_.push_back(std::make_unique<interp::SettingsFileLock>(*path));
+    }
+
+  private:
+    std::vector<std::unique_ptr<interp::SettingsFileLock>> locks_;
+};
+
 // The back end a machine runs programs with: an interp::Executor started from the options'
 // settings, each change saved before the interpreter goes on. A failed save is an error of the
 // block that made the change: `prog.ngc:3:1: settings not saved: …`. Give the interpreter this
 // object as its BlockExecutor, and executor() as its MachineQuery where it needs one.
 class MachineExecutor final : public interp::BlockExecutor {
   public:
+    // Throws std::runtime_error when another run holds the settings files (StateLocks).
     MachineExecutor(interp::CanonSink& sink, const Options& o)
-        : saver_(o.state, o.settings), exec_(sink, backend_config(o), o.settings) {
+        : locks_(o.state), saver_(o.state, o.settings), exec_(sink, backend_config(o), o.settings) {
         exec_.on_settings_changed([this](const interp::Settings& s) { save(s); });
     }
     MachineExecutor(const MachineExecutor&) = delete;
@@ -136,6 +155,7 @@ class MachineExecutor final : public interp::BlockExecutor {
         }
     }
 
+    StateLocks locks_;  // first in, last out: held while anything here may save
     StateSaver saver_;
     interp::Executor exec_;
     interp::SourceLoc at_;  // the block being executed

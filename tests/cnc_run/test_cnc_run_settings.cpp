@@ -4,9 +4,11 @@
 // never write into configs/sim. Positions are checked by hand from configs/sim/mill.ini
 // (X 0..400, Y 0..300, Z -100..0), configs/sim/sim.tbl (T1 Z40, T2 Z35) and the programs.
 // NcStudio writes work offsets with G922 P<n> (P0 = G54) and tool lengths with G923; ISO's
-// G10 L2 is not implemented by the interpreter.
+// G10 L2 is not implemented by the interpreter. A hand-written tool table keeps its lines and
+// words; a second run on the same files at once is refused.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -14,6 +16,7 @@
 #include <vector>
 
 #include "cnc_run_harness.hpp"
+#include "interp/persist.hpp"
 
 namespace {
 
@@ -107,12 +110,12 @@ TEST(CncRunSettings, ToolLengthWrittenInOneRunIsUsedInTheNextAndTheShippedTableS
     const Machine m;
     const RunResult set = m.run("set.ngc", "G90 G21\nG923 P1 Z30\nM30\n");
     ASSERT_EQ(set.exit_code, 0) << set.err << set.out;
-    // The whole table, in tool order, T1 changed and the comments kept.
+    // The shipped table with T1's Z40 changed to Z30 and nothing else.
     EXPECT_EQ(slurp(m.file("sim.tbl")),
-              "T1 P1 Z30 D6 ;6 mm flat end mill\n"
-              "T2 P2 Z35 D3 ;3 mm flat end mill\n"
-              "T3 P3 Z45 D6 ;6 mm ball end mill\n"
-              "T4 P4 Z50 D10 ;10 mm drill\n");
+              "T1 P1 D6 Z30 ;6 mm flat end mill\n"
+              "T2 P2 D3 Z35 ;3 mm flat end mill\n"
+              "T3 P3 D6 Z45 ;6 mm ball end mill\n"
+              "T4 P4 D10 Z50 ;10 mm drill\n");
     EXPECT_EQ(slurp(kSimDir / "sim.tbl"), shipped);
     // The settings file holds no tools while a tool table is kept.
     EXPECT_EQ(slurp(m.file("mill.var")).find("tool "), std::string::npos);
@@ -120,6 +123,35 @@ TEST(CncRunSettings, ToolLengthWrittenInOneRunIsUsedInTheNextAndTheShippedTableS
     const RunResult use = m.run("use.ngc", "G90 G21\nT1 M6\nG43 H1 G0 Z-60\nM30\n");
     ASSERT_EQ(use.exit_code, 0) << use.err << use.out;
     expect_xyz(use, 0, 0, -30);
+}
+
+// A machine builder's hand-written table: G923 changes one number in it and adds the tool it
+// creates at the end; every other byte stays (LinuxCNC's words we ignore, comments, order).
+TEST(CncRunSettings, AHandWrittenToolTableKeepsEverythingButTheChangedValue) {
+    const Machine m;
+    fs::create_directories(m.settings_dir());
+    const std::string hand =
+        "; mill 3, tools measured 2026-11-02\n"
+        ";T P  X Y Z   A B C U V W D  I J Q\n"
+        "T4 P4 X0 Y0 Z50 A0 B0 C0 U0 V0 W0 D10 I0 J0 Q0 ;10 mm drill\n"
+        "\n"
+        "T2 P2 D3.000 Z35.000 Q2   ;  3 mm flat end mill\n"
+        "t1 p1 d6 z+40 ;lower case\n";
+    std::ofstream(m.file("sim.tbl")) << hand;
+    const RunResult set = m.run("set.ngc", "G90 G21\nG923 P2 Z36.25\nG923 P9 Z12\nM30\n");
+    ASSERT_EQ(set.exit_code, 0) << set.err << set.out;
+    EXPECT_EQ(slurp(m.file("sim.tbl")),
+              "; mill 3, tools measured 2026-11-02\n"
+              ";T P  X Y Z   A B C U V W D  I J Q\n"
+              "T4 P4 X0 Y0 Z50 A0 B0 C0 U0 V0 W0 D10 I0 J0 Q0 ;10 mm drill\n"
+              "\n"
+              "T2 P2 D3.000 Z36.25 Q2   ;  3 mm flat end mill\n"
+              "t1 p1 d6 z+40 ;lower case\n"
+              "T9 P9 Z12 D0\n");
+    // why: T2 is now 36.25 mm long; Z-60 under G43 H2 is machine Z-60+36.25 = -23.75.
+    const RunResult use = m.run("use.ngc", "G90 G21\nT2 M6\nG43 H2 G0 Z-60\nM30\n");
+    ASSERT_EQ(use.exit_code, 0) << use.err << use.out;
+    expect_xyz(use, 0, 0, -23.75);
 }
 
 TEST(CncRunSettings, BadSettingsLineRefusesToStart) {
@@ -165,6 +197,52 @@ TEST(CncRunSettings, FailedSaveIsAnErrorOfTheBlockAndKeepsTheOldFile) {
     const RunResult use = m.run("use.ngc", "G90 G21\nG0 X0 Y0\nM30\n");
     ASSERT_EQ(use.exit_code, 0) << use.err << use.out;
     expect_xyz(use, 10, 20, 0);
+}
+
+// Two runs on the same settings at once: the second is refused before it runs a block, naming
+// the file and the first's process id, and its change is not saved. This test process holds
+// the lock, as a first run would (interp::SettingsFileLock, the lock every run takes).
+TEST(CncRunSettings, ASecondRunOnTheSameSettingsIsRefused) {
+    const Machine m;
+    ASSERT_EQ(m.run("set.ngc", "G90 G21\nG922 P0 X10\nM30\n").exit_code, 0);
+    const std::string before = slurp(m.file("mill.var"));
+    for (const std::string name : {"mill.var", "sim.tbl"}) {
+        const interp::SettingsFileLock held(m.file(name).string());
+        const RunResult r = m.run("change.ngc", "G90 G21\nG922 P0 X20\nG923 P1 Z30\nM30\n");
+        EXPECT_EQ(r.exit_code, 1) << r.out;
+        EXPECT_NE(r.err.find(fmt::format("{}: settings file in use by another run (pid {}); two "
+                                         "runs on the same settings would overwrite each "
+                                         "other's changes",
+                                         m.file(name).string(), ::getpid())),
+                  std::string::npos)
+            << r.err;
+        EXPECT_EQ(slurp(m.file("mill.var")), before);
+        EXPECT_FALSE(fs::exists(m.file("sim.tbl")));
+    }
+    // Once the first run has let go the next one runs: G54 at X20, so work X0 is machine X20.
+    ASSERT_EQ(m.run("change.ngc", "G90 G21\nG922 P0 X20\nG0 X0\nM30\n").exit_code, 0);
+    const RunResult use = m.run("use.ngc", "G90 G21\nG0 X0\nM30\n");
+    ASSERT_EQ(use.exit_code, 0) << use.err << use.out;
+    expect_xyz(use, 20, 0, 0);
+}
+
+// NcStudio's numbered variables #1-#999 are program-global (VAR-01): none is kept for the next
+// run, #500-#999 included. Their persistence is Fanuc macro B's (FEATURES.md MAC-02, the ISO
+// dialect's extension), which no manual gives NcStudio and the interpreter does not have yet.
+TEST(CncRunSettings, NumberedVariablesStartUnsetInTheNextRun) {
+    const Machine m;
+    const RunResult set =
+        m.run("set.ngc", "G90 G21\n#500 = 12.5\n#999 = 1\n#100 = 3\nG0 X=#500\nM30\n");
+    ASSERT_EQ(set.exit_code, 0) << set.err << set.out;
+    expect_xyz(set, 12.5, 0, 0);
+    EXPECT_FALSE(fs::exists(m.file("mill.var")));  // nothing to keep, nothing written
+    for (int n : {500, 999, 100}) {
+        const RunResult use = m.run("use.ngc", fmt::format("G90 G21\nG0 X=#{}\nM30\n", n));
+        EXPECT_EQ(use.exit_code, 1) << use.out;
+        EXPECT_NE(use.err.find(fmt::format("use.ngc:2:6: variable #{} is used before it is set", n)),
+                  std::string::npos)
+            << use.err;
+    }
 }
 
 // An INI without [EMCIO]TOOL_TABLE keeps the tools in the settings file.

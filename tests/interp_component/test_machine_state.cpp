@@ -133,4 +133,40 @@ TEST_F(Folder, OnlyWhatChangedIsWritten) {
     EXPECT_FALSE(fs::exists(f.tool_table));
 }
 
+// A machine builder's hand-written table survives a save by the machine's own path (load_state,
+// then StateSaver): every line as written but the one changed number. The expected file is the
+// seed with "Z35" replaced by "Z36.25" by hand.
+TEST_F(Folder, AHandWrittenToolTableKeepsEverythingButTheChangedValue) {
+    const std::string hand =
+        "; Smith mill\n"
+        "T3 P3 X0.5 Y0 Z45 A0 B0 C0 U0 V0 W0 D6 I0 J0 Q0 ;ball end mill\n"
+        "\n"
+        "T1 P1 Z35 D3 Q1 ;drill\n";
+    StateFiles f;
+    f.settings = (dir_ / "m.var").string();
+    f.tool_table = (dir_ / "t.tbl").string();
+    f.tool_table_seed = (dir_ / "seed.tbl").string();
+    std::ofstream(f.tool_table_seed) << hand;
+    interp::Settings s = machine_program::load_state(f);
+    machine_program::StateSaver saver(f, s);
+    s.tools.at(1).offset_mm[2] = 36.25;
+    saver.save(s);
+    EXPECT_EQ(cnc_test::slurp(f.tool_table),
+              "; Smith mill\n"
+              "T3 P3 X0.5 Y0 Z45 A0 B0 C0 U0 V0 W0 D6 I0 J0 Q0 ;ball end mill\n"
+              "\n"
+              "T1 P1 Z36.25 D3 Q1 ;drill\n");
+    EXPECT_EQ(cnc_test::slurp(f.tool_table_seed), hand);
+    EXPECT_FALSE(fs::exists(f.settings));
+    // A tool the program creates goes at the end.
+    s.tools.at(2).offset_mm[2] = 20;
+    saver.save(s);
+    EXPECT_EQ(cnc_test::slurp(f.tool_table),
+              "; Smith mill\n"
+              "T3 P3 X0.5 Y0 Z45 A0 B0 C0 U0 V0 W0 D6 I0 J0 Q0 ;ball end mill\n"
+              "\n"
+              "T1 P1 Z36.25 D3 Q1 ;drill\n"
+              "T2 P2 Z20 D0\n");
+}
+
 }  // namespace

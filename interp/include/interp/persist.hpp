@@ -35,12 +35,42 @@ std::string format_settings(const Settings& s);
 // Throws std::runtime_error with the path and errno text on failure; the old file stays intact.
 void save_settings_atomic(const std::string& path, const Settings& s);
 
-// A tool table in LinuxCNC's .tbl form, one line per tool in tool order:
-// "T1 P1 Z40 D6 ;comment" (X and Y only when not 0; a tool without a pocket gets P = its
-// number). What load_linuxcnc_tool_table reads and ignores (A B C U V W I J Q words, comment
-// lines, the order of the lines) is not written back.
-std::string format_linuxcnc_tool_table(const ToolTable& t);
-// Written as save_settings_atomic writes the settings, with the same guarantees and errors.
-void save_tool_table_atomic(const std::string& path, const ToolTable& t);
+// Writes `t` into the LinuxCNC .tbl file `path` as update_linuxcnc_tool_table of the table the
+// file holds now or, while it does not exist, of `seed` (none: a new table), so that the words,
+// comments and line order of a hand-written table survive. Atomic as save_settings_atomic, with
+// its errors; a table on disk that no longer reads throws interp::Error "file:line:col: cause".
+// Either way `path` keeps its old contents.
+void save_tool_table_atomic(const std::string& path, const ToolTable& t,
+                            const std::string& seed = "");
+
+// Where SettingsFileLock keeps its lock files: one fixed folder, so that every run on this
+// computer finds the same lock for the same settings file whatever its environment, and nothing
+// is written beside the settings (a config or test folder).
+inline constexpr const char* kSettingsLockDir = "/tmp/cnc-settings-locks";
+
+// An exclusive advisory lock (flock) on one settings file (or tool table) for as long as the
+// object lives: a run that may save the file holds it, so that a second run on the same file
+// is refused instead of silently overwriting the first one's changes (the last save would win).
+// The lock is on a file in `lock_dir` named after the settings file's real path (symbolic links
+// resolved), not on the settings file itself, which every save replaces. The holder writes its
+// process id into it; the lock file goes when the holder lets go (or dies: the kernel drops the
+// lock). Advisory: only programs that take it are kept out.
+class SettingsFileLock {
+  public:
+    // Throws std::runtime_error "PATH: settings file in use by another run (pid N) ..." when
+    // held, "PATH: cannot lock settings file: LOCKFILE: cause" when the lock cannot be taken.
+    explicit SettingsFileLock(const std::string& path, const std::string& lock_dir = kSettingsLockDir);
+    ~SettingsFileLock();
+    SettingsFileLock(const SettingsFileLock&) = delete;
+    SettingsFileLock& operator=(const SettingsFileLock&) = delete;
+
+    // The lock file for `path` (its real path's last part and a hash of the whole).
+    static std::string lock_file_of(const std::string& path,
+                                    const std::string& lock_dir = kSettingsLockDir);
+
+  private:
+    std::string lock_file_;
+    int fd_ = -1;
+};
 
 }  // namespace interp

@@ -37,4 +37,19 @@ ToolTable load_linuxcnc_tool_table(const std::string& path);
 // The same from text already in memory; `name` is used in error messages.
 ToolTable parse_linuxcnc_tool_table(const std::string& text, const std::string& name);
 
+// A new table in the .tbl form, one line per tool in tool order: "T1 P1 Z40 D6 ;comment" (X and
+// Y only when not 0; a tool without a pocket gets P = its number).
+std::string format_linuxcnc_tool_table(const ToolTable& t);
+
+// `old_text` (a table parse_linuxcnc_tool_table accepts, `name` in its errors) rewritten to hold
+// `t`, so that a machine builder's hand-written table survives a save. Every byte of it stays as
+// it was (the words the reader ignores, comments, blank and comment-only lines, line order, line
+// endings) except: the number of a P D X Y Z word whose value differs from the tool's in `t`
+// (written in shortest round-trip form), such a word added before the comment when the line has
+// none and the new value is not 0, and the comment when the tool's differs. A line whose tool is
+// not in `t` stays as it is; tools of `t` without a line are appended in tool order in
+// format_linuxcnc_tool_table's form. Throws interp::Error "name:line:col: cause" for a bad line.
+std::string update_linuxcnc_tool_table(const std::string& old_text, const ToolTable& t,
+                                       const std::string& name);
+
 }  // namespace interp

@@ -3,10 +3,14 @@
 
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <charconv>
+#include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -216,24 +220,128 @@ void save_settings_atomic(const std::string& path, const Settings& s) {
     write_file_atomic(path, format_settings(s), "settings");
 }
 
-std::string format_linuxcnc_tool_table(const ToolTable& t) {
-    std::string out;
-    for (const auto& [n, e] : t.entries()) {
-        // A tool the program created (G923) has no pocket: it gets its own number, as a
-        // LinuxCNC sim table numbers them.
-        out += fmt::format("T{} P{}", n, e.pocket != 0 ? e.pocket : n);
-        // X and Y only when set, as LinuxCNC writes them; a mill's length (Z) always.
-        if (e.offset_mm[0] != 0) out += fmt::format(" X{}", e.offset_mm[0]);
-        if (e.offset_mm[1] != 0) out += fmt::format(" Y{}", e.offset_mm[1]);
-        out += fmt::format(" Z{} D{}", e.offset_mm[2], e.diameter_mm);
-        if (!e.comment.empty()) out += " ;" + e.comment;
-        out += "\n";
+namespace {
+
+// The table a save starts from: `path` once it exists, else `seed`, else none ("").
+struct TableText {
+    std::string file;
+    std::string text;
+};
+
+TableText tool_table_base(const std::string& path, const std::string& seed) {
+    std::error_code ec;
+    std::string from = path;
+    if (!std::filesystem::exists(path, ec)) {
+        if (seed.empty() || !std::filesystem::exists(seed, ec)) return {};
+        from = seed;
     }
-    return out;
+    if (std::filesystem::is_directory(from, ec)) sys_fail("cannot read tool table", from, EISDIR);
+    std::ifstream f(from, std::ios::binary);
+    if (!f) sys_fail("cannot read tool table", from, errno);
+    std::ostringstream ss;
+    ss << f.rdbuf();
+    if (f.bad()) sys_fail("cannot read tool table", from, EIO);
+    return {from, ss.str()};
 }
 
-void save_tool_table_atomic(const std::string& path, const ToolTable& t) {
-    write_file_atomic(path, format_linuxcnc_tool_table(t), "tool table");
+}  // namespace
+
+void save_tool_table_atomic(const std::string& path, const ToolTable& t, const std::string& seed) {
+    const TableText base = tool_table_base(path, seed);
+    write_file_atomic(path, update_linuxcnc_tool_table(base.text, t, base.file), "tool table");
+}
+
+namespace {
+
+// FNV-1a: a hash every build computes alike, so that two builds name the same lock file.
+std::uint64_t fnv1a(std::string_view s) {
+    std::uint64_t h = 1469598103934665603ULL;
+    for (char c : s) {
+        h ^= static_cast<unsigned char>(c);
+        h *= 1099511628211ULL;
+    }
+    return h;
+}
+
+// The process id the holder wrote into its lock file; 0 when none is there yet.
+long holder_of(int fd) {
+    char buf[32] = {};
+    if (::pread(fd, buf, sizeof buf - 1, 0) <= 0) return 0;
+    return std::strtol(buf, nullptr, 10);
+}
+
+bool same_file(int fd, const std::string& path) {
+    struct stat held {};
+    struct stat named {};
+    return ::fstat(fd, &held) == 0 && ::stat(path.c_str(), &named) == 0 &&
+           held.st_dev == named.st_dev && held.st_ino == named.st_ino;
+}
+
+int lock_now(int fd) {
+    int r = 0;
+    while ((r = ::flock(fd, LOCK_EX | LOCK_NB)) != 0 && errno == EINTR) {
+    }
+    return r == 0 ? 0 : errno;
+}
+
+}  // namespace
+
+std::string SettingsFileLock::lock_file_of(const std::string& path, const std::string& lock_dir) {
+    std::error_code ec;
+    std::filesystem::path real = std::filesystem::weakly_canonical(path, ec);
+    if (ec) real = std::filesystem::absolute(path, ec).lexically_normal();
+    return (std::filesystem::path(lock_dir) /
+            fmt::format("{}-{:016x}.lock", real.filename().string(), fnv1a(real.string())))
+        .string();
+}
+
+SettingsFileLock::SettingsFileLock(const std::string& path, const std::string& lock_dir)
+    : lock_file_(lock_file_of(path, lock_dir)) {
+    auto fail = [&](int err) {
+        throw std::runtime_error(fmt::format("{}: cannot lock settings file: {}: {}", path,
+                                             lock_file_, std::strerror(err)));
+    };
+    // Open to every user like /tmp (the umask would narrow mkdir's mode): runs of other users on
+    // the same settings files must find the same locks.
+    if (::mkdir(lock_dir.c_str(), 01777) == 0)
+        ::chmod(lock_dir.c_str(), 01777);
+    else if (errno != EEXIST)
+        fail(errno);
+    // A holder removes its lock file as it lets go; a lock taken on the file it removed would
+    // keep nobody out, so such a lock is dropped and taken again on the new file.
+    for (int attempt = 0; attempt < 100; ++attempt) {
+        int fd = ::open(lock_file_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0666);
+        if (fd < 0 && errno == EACCES)  // another user's lock file: flock needs no write access
+            fd = ::open(lock_file_.c_str(), O_RDONLY | O_CLOEXEC);
+        if (fd < 0) fail(errno);
+        if (const int err = lock_now(fd); err != 0) {
+            const long pid = err == EWOULDBLOCK ? holder_of(fd) : 0;
+            ::close(fd);
+            if (err != EWOULDBLOCK) fail(err);
+            throw std::runtime_error(fmt::format(
+                "{}: settings file in use by another run ({}); two runs on the same settings "
+                "would overwrite each other's changes",
+                path, pid > 0 ? fmt::format("pid {}", pid) : std::string("holder unknown")));
+        }
+        if (!same_file(fd, lock_file_)) {
+            ::close(fd);
+            continue;
+        }
+        fd_ = fd;
+        // Only the refusal message of another run reads this: a failed write changes nothing.
+        const std::string pid = fmt::format("{}\n", ::getpid());
+        [[maybe_unused]] const bool written =
+            ::ftruncate(fd_, 0) == 0 && ::pwrite(fd_, pid.data(), pid.size(), 0) > 0;
+        return;
+    }
+    fail(EAGAIN);
+}
+
+SettingsFileLock::~SettingsFileLock() {
+    if (fd_ < 0) return;
+    // Removed while still locked, so no one can lock this file after we let go (see above).
+    ::unlink(lock_file_.c_str());
+    ::close(fd_);
 }
 
 }  // namespace interp

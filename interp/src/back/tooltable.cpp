@@ -1,10 +1,19 @@
-// LinuxCNC .tbl reader: one tool per line, words T P D X Y Z A B C U V W I J Q, ';' comment.
+// LinuxCNC .tbl reader and writer: one tool per line, words T P D X Y Z A B C U V W I J Q, ';'
+// comment. The writer edits the file's own text so that what the reader ignores survives.
 #include "interp/tooltable.hpp"
 
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <fstream>
+#include <functional>
+#include <optional>
+#include <set>
 #include <sstream>
+#include <vector>
 
 #include "interp/block.hpp"
 
@@ -23,23 +32,79 @@ bool read_number(const std::string& s, std::size_t& pos, double& out) {
     return true;
 }
 
-void parse_line(const std::string& line, std::string_view name, int line_no, ToolTable& table) {
-    auto err = [&](std::size_t col, const std::string& why) {
-        throw Error(SourceLoc{name, line_no, static_cast<int>(col) + 1}, why);
-    };
-    std::string comment;
-    std::string body = line;
-    if (auto semi = line.find(';'); semi != std::string::npos) {
-        comment = line.substr(semi + 1);
-        body = line.substr(0, semi);
-        while (!comment.empty() && std::isspace(static_cast<unsigned char>(comment.front())))
-            comment.erase(comment.begin());
-    }
+// One word of a line: its letter (upper case) and where its number is, so that a rewrite can
+// replace just the number.
+struct Word {
+    char letter;
+    std::size_t num_begin;
+    std::size_t num_end;
+};
+
+// A line as read: the entry it gives (the last of a repeated word wins), its words in order and
+// where its comment is.
+struct ParsedLine {
     std::optional<int> tool;
-    ToolEntry e;
-    e.comment = comment;
+    ToolEntry entry;
+    std::vector<Word> words;
+    std::optional<std::size_t> semi;  // the ';'
+    std::size_t comment_begin = 0;    // first non-blank after the ';'
+};
+
+void apply_word(char c, double v, std::size_t col, ParsedLine& p,
+                const std::function<void(std::size_t, const std::string&)>& err) {
+    switch (c) {
+        case 'T':
+            if (v < 0 || v != static_cast<int>(v)) err(col, "tool table: bad tool number");
+            p.tool = static_cast<int>(v);
+            break;
+        case 'P':
+            p.entry.pocket = static_cast<int>(v);
+            break;
+        case 'D':
+            if (v < 0) err(col, "tool table: negative diameter");
+            p.entry.diameter_mm = v;
+            break;
+        case 'X':
+        case 'Y':
+        case 'Z':
+            p.entry.offset_mm[c - 'X'] = v;
+            break;
+        // Rotary/UVW offsets and lathe orientation words exist in LinuxCNC tables; a mill's
+        // offset vector has no place for them, so they are read, ignored and kept on rewrite.
+        case 'A':
+        case 'B':
+        case 'C':
+        case 'U':
+        case 'V':
+        case 'W':
+        case 'I':
+        case 'J':
+        case 'Q':
+            break;
+        default:
+            err(col, std::string("tool table: unknown word '") + c + "'");
+    }
+}
+
+// `line` without its line ending.
+ParsedLine parse_line(const std::string& line, std::string_view name, int line_no) {
+    const std::function<void(std::size_t, const std::string&)> err =
+        [&](std::size_t col, const std::string& why) {
+            throw Error(SourceLoc{name, line_no, static_cast<int>(col) + 1}, why);
+        };
+    ParsedLine p;
+    std::size_t body_end = line.size();
+    if (auto semi = line.find(';'); semi != std::string::npos) {
+        p.semi = semi;
+        body_end = semi;
+        p.comment_begin = semi + 1;
+        while (p.comment_begin < line.size() &&
+               std::isspace(static_cast<unsigned char>(line[p.comment_begin])))
+            ++p.comment_begin;
+        p.entry.comment = line.substr(p.comment_begin);
+    }
+    const std::string body = line.substr(0, body_end);
     std::size_t pos = 0;
-    bool any = false;
     while (pos < body.size()) {
         const char c = static_cast<char>(std::toupper(static_cast<unsigned char>(body[pos])));
         if (std::isspace(static_cast<unsigned char>(c))) {
@@ -48,65 +113,103 @@ void parse_line(const std::string& line, std::string_view name, int line_no, Too
         }
         const std::size_t word_col = pos;
         ++pos;
+        const std::size_t num_begin = pos;
         double v = 0;
         if (!read_number(body, pos, v))
             err(pos, std::string("tool table: expected a number after '") + c + "'");
-        any = true;
-        switch (c) {
-            case 'T':
-                if (v < 0 || v != static_cast<int>(v)) err(word_col, "tool table: bad tool number");
-                tool = static_cast<int>(v);
-                break;
-            case 'P':
-                e.pocket = static_cast<int>(v);
-                break;
-            case 'D':
-                if (v < 0) err(word_col, "tool table: negative diameter");
-                e.diameter_mm = v;
-                break;
-            case 'X':
-                e.offset_mm[0] = v;
-                break;
-            case 'Y':
-                e.offset_mm[1] = v;
-                break;
-            case 'Z':
-                e.offset_mm[2] = v;
-                break;
-            // Rotary/UVW offsets and lathe orientation words exist in LinuxCNC tables; a mill's
-            // offset vector has no place for them, so they are read and ignored.
-            case 'A':
-            case 'B':
-            case 'C':
-            case 'U':
-            case 'V':
-            case 'W':
-            case 'I':
-            case 'J':
-            case 'Q':
-                break;
-            default:
-                err(word_col, std::string("tool table: unknown word '") + c + "'");
-        }
+        // from_chars reads "inf" and "nan": a length like that would send the machine anywhere.
+        if (!std::isfinite(v)) err(num_begin, "tool table: value is not a finite number");
+        p.words.push_back(Word{c, num_begin, pos});
+        apply_word(c, v, word_col, p, err);
     }
-    if (!any) return;  // blank or comment-only line
-    if (!tool) err(0, "tool table: line has no T word");
-    if (table.find(*tool)) err(0, "tool table: tool " + std::to_string(*tool) + " listed twice");
-    table.at(*tool) = e;
+    if (!p.words.empty() && !p.tool) err(0, "tool table: line has no T word");
+    return p;
+}
+
+// Calls `each(line, ending, parsed)` for every line of `text`; `ending` is what ended the line
+// ("\r\n", "\n", or "" for a last line without one). Checks the whole table first, so that
+// nothing is written from a table the reader would refuse.
+template <typename Each>
+void for_each_line(const std::string& text, std::string_view name, Each each) {
+    std::set<int> tools;
+    std::size_t start = 0;
+    int line_no = 0;
+    while (start < text.size()) {
+        const std::size_t nl = text.find('\n', start);
+        const std::size_t end = nl == std::string::npos ? text.size() : nl;
+        std::string line = text.substr(start, end - start);
+        std::string ending = nl == std::string::npos ? "" : "\n";
+        if (!line.empty() && line.back() == '\r') {
+            line.pop_back();
+            ending.insert(ending.begin(), '\r');
+        }
+        ++line_no;
+        ParsedLine p = parse_line(line, name, line_no);
+        if (p.tool && !tools.insert(*p.tool).second)
+            throw Error(SourceLoc{name, line_no, 1},
+                        "tool table: tool " + std::to_string(*p.tool) + " listed twice");
+        each(line, ending, p);
+        start = end == text.size() ? end : end + 1;
+    }
+}
+
+// Replaces `erase` characters at `at` with `text`.
+struct Edit {
+    std::size_t at;
+    std::size_t erase;
+    std::string text;
+};
+
+// `line` holding `now` in place of what `was` parsed from it (see update_linuxcnc_tool_table).
+std::string updated_line(std::string line, const ParsedLine& was, const ToolEntry& now) {
+    std::vector<Edit> edits;
+    std::string added;  // words the line lacks, written after its last word
+    auto sync = [&](char letter, bool same, const std::string& text) {
+        if (same) return;
+        auto it = std::find_if(was.words.rbegin(), was.words.rend(),
+                               [&](const Word& w) { return w.letter == letter; });
+        if (it != was.words.rend())
+            edits.push_back(Edit{it->num_begin, it->num_end - it->num_begin, text});
+        else
+            added += fmt::format(" {}{}", letter, text);
+    };
+    sync('P', was.entry.pocket == now.pocket, fmt::format("{}", now.pocket));
+    for (int a = 0; a < 3; ++a)
+        sync(static_cast<char>('X' + a), was.entry.offset_mm[a] == now.offset_mm[a],
+             fmt::format("{}", now.offset_mm[a]));
+    sync('D', was.entry.diameter_mm == now.diameter_mm, fmt::format("{}", now.diameter_mm));
+    if (!added.empty()) edits.push_back(Edit{was.words.back().num_end, 0, added});
+    if (was.entry.comment != now.comment) {
+        if (was.semi)
+            edits.push_back(Edit{was.comment_begin, line.size() - was.comment_begin, now.comment});
+        else
+            edits.push_back(Edit{line.size(), 0, " ;" + now.comment});
+    }
+    // Back to front, so every edit's position is still where it was parsed.
+    std::sort(edits.begin(), edits.end(), [](const Edit& a, const Edit& b) { return a.at > b.at; });
+    for (const Edit& e : edits) line.replace(e.at, e.erase, e.text);
+    return line;
+}
+
+std::string new_line(int n, const ToolEntry& e) {
+    // A tool the program created (G923) has no pocket: it gets its own number, as a LinuxCNC
+    // sim table numbers them.
+    std::string out = fmt::format("T{} P{}", n, e.pocket != 0 ? e.pocket : n);
+    // X and Y only when set, as LinuxCNC writes them; a mill's length (Z) always.
+    if (e.offset_mm[0] != 0) out += fmt::format(" X{}", e.offset_mm[0]);
+    if (e.offset_mm[1] != 0) out += fmt::format(" Y{}", e.offset_mm[1]);
+    out += fmt::format(" Z{} D{}", e.offset_mm[2], e.diameter_mm);
+    if (!e.comment.empty()) out += " ;" + e.comment;
+    return out;
 }
 
 }  // namespace
 
 ToolTable parse_linuxcnc_tool_table(const std::string& text, const std::string& name) {
     ToolTable table;
-    std::istringstream in(text);
-    std::string line;
-    int line_no = 0;
-    while (std::getline(in, line)) {
-        ++line_no;
-        if (!line.empty() && line.back() == '\r') line.pop_back();
-        parse_line(line, name, line_no, table);
-    }
+    for_each_line(text, name, [&](const std::string&, const std::string&, const ParsedLine& p) {
+        if (p.tool) table.at(*p.tool) = p.entry;
+    });
     return table;
 }
 
@@ -116,6 +219,34 @@ ToolTable load_linuxcnc_tool_table(const std::string& path) {
     std::ostringstream ss;
     ss << f.rdbuf();
     return parse_linuxcnc_tool_table(ss.str(), path);
+}
+
+std::string format_linuxcnc_tool_table(const ToolTable& t) {
+    return update_linuxcnc_tool_table("", t, "");
+}
+
+std::string update_linuxcnc_tool_table(const std::string& old_text, const ToolTable& t,
+                                       const std::string& name) {
+    std::string out;
+    std::set<int> listed;
+    for_each_line(old_text, name,
+                  [&](const std::string& line, const std::string& ending, const ParsedLine& p) {
+                      const ToolEntry* now = p.tool ? t.find(*p.tool) : nullptr;
+                      out += now ? updated_line(line, p, *now) : line;
+                      out += ending;
+                      if (p.tool) listed.insert(*p.tool);
+                  });
+    // New lines end as the file's first line does (a table written on Windows keeps "\r\n").
+    const std::size_t nl = old_text.find('\n');
+    const std::string ending = nl != std::string::npos && nl > 0 && old_text[nl - 1] == '\r'
+                                   ? "\r\n"
+                                   : "\n";
+    for (const auto& [n, e] : t.entries()) {
+        if (listed.count(n)) continue;
+        if (!out.empty() && out.back() != '\n') out += ending;
+        out += new_line(n, e) + ending;
+    }
+    return out;
 }
 
 }  // namespace interp

@@ -1,14 +1,17 @@
 // Persistent settings and LinuxCNC tool tables: round trips, atomic replacement, and one test
 // per error message.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
+#include <memory>
 
 #include "interp/block.hpp"
 #include "interp/persist.hpp"
 #include "interp/tooltable.hpp"
+#include "scratch_dir.hpp"
 
 namespace interp {
 namespace {
@@ -158,6 +161,57 @@ TEST(ToolTable, MissingFileIsAnError) {
         EXPECT_NE(what.find("/nonexistent-dir-iback/x.tbl"), std::string::npos) << what;
         EXPECT_NE(what.find("cannot open tool table"), std::string::npos) << what;
     }
+}
+
+std::string error_of_lock(const std::string& path, const std::string& lock_dir) {
+    try {
+        SettingsFileLock lock(path, lock_dir);
+    } catch (const std::runtime_error& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+// flock locks of two open() calls conflict even in one process, so one test process stands in
+// for two runs.
+TEST(SettingsLock, ASecondRunOnTheSameFileIsRefusedNamingTheFileAndTheHolder) {
+    const cnc_test::ScratchDir scratch;
+    const std::string locks = (scratch.path() / "locks").string();
+    const std::string file = (scratch.path() / "m.var").string();
+    auto held = std::make_unique<SettingsFileLock>(file, locks);
+    EXPECT_EQ(error_of_lock(file, locks),
+              fmt::format("{}: settings file in use by another run (pid {}); two runs on the "
+                          "same settings would overwrite each other's changes",
+                          file, ::getpid()));
+    // Another way to the same file is the same file.
+    fs::create_directory_symlink(scratch.path(), scratch.path() / "link");
+    EXPECT_NE(error_of_lock((scratch.path() / "link/m.var").string(), locks).find("in use"),
+              std::string::npos);
+    EXPECT_NE(error_of_lock((scratch.path() / "./m.var").string(), locks).find("in use"),
+              std::string::npos);
+    // Another file is not held.
+    EXPECT_EQ(error_of_lock((scratch.path() / "other.var").string(), locks), "no error");
+    held.reset();
+    EXPECT_EQ(error_of_lock(file, locks), "no error");
+    // A holder that lets go removes its lock file.
+    EXPECT_TRUE(fs::is_empty(locks));
+}
+
+TEST(SettingsLock, ALockFolderThatCannotBeMadeIsNamed) {
+    const cnc_test::ScratchDir scratch;
+    std::ofstream(scratch.path() / "plain") << "x";
+    const std::string locks = (scratch.path() / "plain/locks").string();
+    const std::string file = (scratch.path() / "m.var").string();
+    EXPECT_EQ(error_of_lock(file, locks),
+              fmt::format("{}: cannot lock settings file: {}: Not a directory", file,
+                          SettingsFileLock::lock_file_of(file, locks)));
+}
+
+TEST(SettingsLock, TheLockFileIsNamedAfterTheSettingsFile) {
+    const std::string lock = SettingsFileLock::lock_file_of("/no-such-dir-iback/m.var", "/L");
+    EXPECT_EQ(lock.rfind("/L/m.var-", 0), 0u) << lock;
+    EXPECT_EQ(lock.size(), std::string("/L/m.var-0123456789abcdef.lock").size()) << lock;
+    EXPECT_NE(lock, SettingsFileLock::lock_file_of("/no-such-dir-iback2/m.var", "/L"));
 }
 
 }  // namespace
