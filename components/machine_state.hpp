@@ -1,9 +1,10 @@
 // What the interpreter remembers between runs on a machine (machine_program::StateFiles: the
 // settings file and the tool table): read with the machine's options, before anything runs, and
 // written back atomically as soon as a block has changed it, so a run that is stopped, aborted
-// or crashes afterwards keeps it. One implementation for both ways a machine runs programs: the
-// interp component's runner and motion's own program feeder (program=). Configuration world:
-// the interpreter's thread.
+// or crashes afterwards keeps it; locked for the run (StateLocks), so that a second run on the
+// same files is refused instead of overwriting the first one's changes. One implementation for
+// both ways a machine runs programs: the interp component's runner and motion's own program
+// feeder (program=). Configuration world: the interpreter's thread.
 #pragma once
 
 #include <fmt/format.h>

@@ -239,8 +239,9 @@ TEST(CncRunSettings, NumberedVariablesStartUnsetInTheNextRun) {
     for (int n : {500, 999, 100}) {
         const RunResult use = m.run("use.ngc", fmt::format("G90 G21\nG0 X=#{}\nM30\n", n));
         EXPECT_EQ(use.exit_code, 1) << use.out;
-        EXPECT_NE(use.err.find(fmt::format("use.ngc:2:6: variable #{} is used before it is set", n)),
-                  std::string::npos)
+        EXPECT_NE(
+            use.err.find(fmt::format("use.ngc:2:6: variable #{} is used before it is set", n)),
+            std::string::npos)
             << use.err;
     }
 }

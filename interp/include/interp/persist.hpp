@@ -59,7 +59,8 @@ class SettingsFileLock {
   public:
     // Throws std::runtime_error "PATH: settings file in use by another run (pid N) ..." when
     // held, "PATH: cannot lock settings file: LOCKFILE: cause" when the lock cannot be taken.
-    explicit SettingsFileLock(const std::string& path, const std::string& lock_dir = kSettingsLockDir);
+    explicit SettingsFileLock(const std::string& path,
+                              const std::string& lock_dir = kSettingsLockDir);
     ~SettingsFileLock();
     SettingsFileLock(const SettingsFileLock&) = delete;
     SettingsFileLock& operator=(const SettingsFileLock&) = delete;

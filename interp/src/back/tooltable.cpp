@@ -9,7 +9,6 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
-#include <functional>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -50,8 +49,16 @@ struct ParsedLine {
     std::size_t comment_begin = 0;    // first non-blank after the ';'
 };
 
-void apply_word(char c, double v, std::size_t col, ParsedLine& p,
-                const std::function<void(std::size_t, const std::string&)>& err) {
+// Throws the error of one column (0-based) of one line.
+struct LineError {
+    std::string_view name;
+    int line_no;
+    [[noreturn]] void operator()(std::size_t col, const std::string& why) const {
+        throw Error(SourceLoc{name, line_no, static_cast<int>(col) + 1}, why);
+    }
+};
+
+void apply_word(char c, double v, std::size_t col, ParsedLine& p, const LineError& err) {
     switch (c) {
         case 'T':
             if (v < 0 || v != static_cast<int>(v)) err(col, "tool table: bad tool number");
@@ -88,10 +95,7 @@ void apply_word(char c, double v, std::size_t col, ParsedLine& p,
 
 // `line` without its line ending.
 ParsedLine parse_line(const std::string& line, std::string_view name, int line_no) {
-    const std::function<void(std::size_t, const std::string&)> err =
-        [&](std::size_t col, const std::string& why) {
-            throw Error(SourceLoc{name, line_no, static_cast<int>(col) + 1}, why);
-        };
+    const LineError err{name, line_no};
     ParsedLine p;
     std::size_t body_end = line.size();
     if (auto semi = line.find(';'); semi != std::string::npos) {
@@ -238,9 +242,8 @@ std::string update_linuxcnc_tool_table(const std::string& old_text, const ToolTa
                   });
     // New lines end as the file's first line does (a table written on Windows keeps "\r\n").
     const std::size_t nl = old_text.find('\n');
-    const std::string ending = nl != std::string::npos && nl > 0 && old_text[nl - 1] == '\r'
-                                   ? "\r\n"
-                                   : "\n";
+    const std::string ending =
+        nl != std::string::npos && nl > 0 && old_text[nl - 1] == '\r' ? "\r\n" : "\n";
     for (const auto& [n, e] : t.entries()) {
         if (listed.count(n)) continue;
         if (!out.empty() && out.back() != '\n') out += ending;
