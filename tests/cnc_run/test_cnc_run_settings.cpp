@@ -62,6 +62,14 @@ void expect_xyz(const RunResult& r, double x, double y, double z) {
     EXPECT_NEAR(p[2], z, 1e-6);
 }
 
+// The next run on `m`'s settings: `program` ends at machine X Y Z.
+void expect_next_run_ends_at(const Machine& m, const std::string& program, double x, double y,
+                             double z) {
+    const RunResult use = m.run("use.ngc", program);
+    ASSERT_EQ(use.exit_code, 0) << use.err << use.out;
+    expect_xyz(use, x, y, z);
+}
+
 TEST(CncRunSettings, WorkOffsetSetInOneRunMovesTheNext) {
     const Machine m;
     const RunResult set = m.run("set.ngc", "G90 G21\nG922 P0 X10 Y20 Z-5\nM30\n");
@@ -70,9 +78,7 @@ TEST(CncRunSettings, WorkOffsetSetInOneRunMovesTheNext) {
     EXPECT_NE(slurp(m.file("mill.var")).find("\nwcs 1 10 20 -5 0 0 0\n"), std::string::npos)
         << slurp(m.file("mill.var"));
     // why: G54's origin is now machine X10 Y20 Z-5, so work X5 Y5 Z0 is machine X15 Y25 Z-5.
-    const RunResult use = m.run("use.ngc", "G90 G21\nG54 G0 X5 Y5 Z0\nM30\n");
-    ASSERT_EQ(use.exit_code, 0) << use.err << use.out;
-    expect_xyz(use, 15, 25, -5);
+    expect_next_run_ends_at(m, "G90 G21\nG54 G0 X5 Y5 Z0\nM30\n", 15, 25, -5);
 }
 
 TEST(CncRunSettings, G92ShiftPersists) {
@@ -80,18 +86,14 @@ TEST(CncRunSettings, G92ShiftPersists) {
     // why: at machine X0 Y0, G92 X-30 Y-40 makes the current point work X-30 Y-40: the shift
     // is +30 +40, so work X0 Y0 of the next run is machine X30 Y40.
     ASSERT_EQ(m.run("set.ngc", "G90 G21\nG92 X-30 Y-40\nM30\n").exit_code, 0);
-    const RunResult use = m.run("use.ngc", "G90 G21\nG0 X0 Y0\nM30\n");
-    ASSERT_EQ(use.exit_code, 0) << use.err << use.out;
-    expect_xyz(use, 30, 40, 0);
+    expect_next_run_ends_at(m, "G90 G21\nG0 X0 Y0\nM30\n", 30, 40, 0);
 }
 
 TEST(CncRunSettings, PersistentParameterWrittenInOneRunIsReadInTheNext) {
     const Machine m;
     ASSERT_EQ(m.run("set.ngc", "G90 G21\n#FIXEDCALI_REC = 12.5\nM30\n").exit_code, 0);
     EXPECT_NE(slurp(m.file("mill.var")).find("\nparam FIXEDCALI_REC 12.5\n"), std::string::npos);
-    const RunResult use = m.run("use.ngc", "G90 G21\nG0 X=#FIXEDCALI_REC\nM30\n");
-    ASSERT_EQ(use.exit_code, 0) << use.err << use.out;
-    expect_xyz(use, 12.5, 0, 0);
+    expect_next_run_ends_at(m, "G90 G21\nG0 X=#FIXEDCALI_REC\nM30\n", 12.5, 0, 0);
 }
 
 TEST(CncRunSettings, ToolLengthComesFromTheTable) {
@@ -120,9 +122,7 @@ TEST(CncRunSettings, ToolLengthWrittenInOneRunIsUsedInTheNextAndTheShippedTableS
     // The settings file holds no tools while a tool table is kept.
     EXPECT_EQ(slurp(m.file("mill.var")).find("tool "), std::string::npos);
     // why: Z-60 + 30 = -30.
-    const RunResult use = m.run("use.ngc", "G90 G21\nT1 M6\nG43 H1 G0 Z-60\nM30\n");
-    ASSERT_EQ(use.exit_code, 0) << use.err << use.out;
-    expect_xyz(use, 0, 0, -30);
+    expect_next_run_ends_at(m, "G90 G21\nT1 M6\nG43 H1 G0 Z-60\nM30\n", 0, 0, -30);
 }
 
 // A machine builder's hand-written table: G923 changes one number in it and adds the tool it
@@ -149,9 +149,7 @@ TEST(CncRunSettings, AHandWrittenToolTableKeepsEverythingButTheChangedValue) {
               "t1 p1 d6 z+40 ;lower case\n"
               "T9 P9 Z12 D0\n");
     // why: T2 is now 36.25 mm long; Z-60 under G43 H2 is machine Z-60+36.25 = -23.75.
-    const RunResult use = m.run("use.ngc", "G90 G21\nT2 M6\nG43 H2 G0 Z-60\nM30\n");
-    ASSERT_EQ(use.exit_code, 0) << use.err << use.out;
-    expect_xyz(use, 0, 0, -23.75);
+    expect_next_run_ends_at(m, "G90 G21\nT2 M6\nG43 H2 G0 Z-60\nM30\n", 0, 0, -23.75);
 }
 
 TEST(CncRunSettings, BadSettingsLineRefusesToStart) {
@@ -194,9 +192,7 @@ TEST(CncRunSettings, FailedSaveIsAnErrorOfTheBlockAndKeepsTheOldFile) {
     EXPECT_EQ(slurp(m.file("mill.var")), before);
     // With the obstacle gone the next run starts from the old offsets: work X0 = machine X10.
     fs::remove(m.file("mill.var.tmp"));
-    const RunResult use = m.run("use.ngc", "G90 G21\nG0 X0 Y0\nM30\n");
-    ASSERT_EQ(use.exit_code, 0) << use.err << use.out;
-    expect_xyz(use, 10, 20, 0);
+    expect_next_run_ends_at(m, "G90 G21\nG0 X0 Y0\nM30\n", 10, 20, 0);
 }
 
 // Two runs on the same settings at once: the second is refused before it runs a block, naming
@@ -221,9 +217,7 @@ TEST(CncRunSettings, ASecondRunOnTheSameSettingsIsRefused) {
     }
     // Once the first run has let go the next one runs: G54 at X20, so work X0 is machine X20.
     ASSERT_EQ(m.run("change.ngc", "G90 G21\nG922 P0 X20\nG0 X0\nM30\n").exit_code, 0);
-    const RunResult use = m.run("use.ngc", "G90 G21\nG0 X0\nM30\n");
-    ASSERT_EQ(use.exit_code, 0) << use.err << use.out;
-    expect_xyz(use, 20, 0, 0);
+    expect_next_run_ends_at(m, "G90 G21\nG0 X0\nM30\n", 20, 0, 0);
 }
 
 // NcStudio's numbered variables #1-#999 are program-global (VAR-01): none is kept for the next
