@@ -69,6 +69,16 @@ constexpr double kOffsetMinCos = -0.02;
 constexpr double kShiftSpeedFactor = 3;
 constexpr double kShiftCentripetal = 0.5;
 constexpr double kShiftMinSpeedFactor = 2;
+// Offset corners with an arc (offset_arc_corner): a move's curvature moves the turn's deepest
+// point, so the cut shrinks by this factor until every piece is proved, at most this many times.
+constexpr double kOffsetArcShrink = 0.9;
+constexpr int kOffsetArcAttempts = 8;
+// They are tried only where both moves allow at least this many times the speed of the blend
+// inside the corner. Below that they gain little and cost much: ex23's 28 arc-line corners at
+// the 10 mm/s feed (1.13 x the inside blend's 8.85 mm/s) gained 11 ms in all as offset corners
+// and halved its planning throughput (the proofs against an arc's chords split its pieces
+// several times); tangent_arcs' arc-rapid corner (40 mm/s, 4.5 x) gains 23 ms.
+constexpr double kOffsetArcMinGain = 1.25;
 // With a jerk limit a Bezier blend (curvature steps at its ends) is used only if its ends can
 // be passed at this share of the feed.
 constexpr double kJerkBlendMinFeedShare = 0.25;
@@ -208,7 +218,7 @@ void Planner::classify(const Piece& p, const Piece& next, Junction& jn) const {
     // one of them is a rapid, at the rapid's speed): cut only what passing at the speed either
     // move allows there (with a margin) needs. The parabola's cap is the model; the Bezier blends
     // with an arc turn a little harder, hence the margin.
-    double l_speed_mm = kInf;
+    double l_speed_mm = kInf, speed_margin = 1;
     if (!jerk_mode_) {
         double pass_mm_s = std::min(p.feed_mm_s > 0 ? p.feed_mm_s : kInf,
                                     next.feed_mm_s > 0 ? next.feed_mm_s : kInf);
@@ -216,10 +226,9 @@ void Planner::classify(const Piece& p, const Piece& next, Junction& jn) const {
             double t = std::max(std::fabs(pe.tangent[k]), std::fabs(ns.tangent[k]));
             if (t > 0) pass_mm_s = std::min(pass_mm_s, lim.vel_mm_s[k] / t);
         }
-        double margin =
-            p.feed_mm_s == next.feed_mm_s ? kCornerSpeedMargin : kMixedCornerSpeedMargin;
-        l_speed_mm =
-            parabola_cut_for_speed_mm(dt, margin * pass_mm_s, lim, {1 - reserve_, 1 - reserve_});
+        speed_margin = p.feed_mm_s == next.feed_mm_s ? kCornerSpeedMargin : kMixedCornerSpeedMargin;
+        l_speed_mm = parabola_cut_for_speed_mm(dt, speed_margin * pass_mm_s, lim,
+                                               {1 - reserve_, 1 - reserve_});
     }
     bool lines = p.geom.kind == ElementKind::Line && next.geom.kind == ElementKind::Line;
     if (lines && p.tolerance_mm > 0) {
@@ -273,9 +282,17 @@ void Planner::classify(const Piece& p, const Piece& next, Junction& jn) const {
     }
     // Kinks with an arc (rounding in the program, or a real corner): a blend where passing
     // the kink would cost speed.
-    if (cap < feed && p.tolerance_mm > 0 && sin_angle < kMaxArcBlendSin &&
-        bezier_corner(p, next, sin_angle, feed, l_speed_mm, jn))
-        return;
+    if (cap < feed && p.tolerance_mm > 0 && sin_angle < kMaxArcBlendSin) {
+        // As between two lines, the corner is cut on the moves carried outwards where the
+        // blend inside it would be much slower than the moves allow (cut lengths grow with the
+        // square of the speed; see kOffsetArcMinGain) and that fits.
+        const double gain = kOffsetArcMinGain * speed_margin;
+        if (!jerk_mode_ &&
+            l_speed_mm > gain * gain * p.tolerance_mm / (kParabolaDeviationPerL * sin_angle) &&
+            offset_arc_corner(p, next, sin_angle, l_speed_mm, jn))
+            return;
+        if (bezier_corner(p, next, sin_angle, feed, l_speed_mm, jn)) return;
+    }
     if (cap < kKinkStopFraction * feed) return jn.set(0, false, 0);
     jn.set(std::min(cap, curvature_cap), true, 0);
 }
@@ -465,6 +482,166 @@ bool Planner::offset_corner(const Piece& p, const Piece& next, double sin_angle,
     return true;
 }
 
+namespace {
+
+// A move carried a distance d along a direction n that turns with it (n is given at one end of
+// the move and is perpendicular to its tangent there): a line becomes the line moved by d n; on
+// an arc or helix the part of n in the arc's plane turns with the arc and the rest stays, so the
+// point at s is p(s) + d N(s) with |N(s)| = |n|, exactly d from the move's point at the same s,
+// and the carried curve is again a circle or helix about the same axis.
+class CarriedMove {
+  public:
+    CarriedMove(const Element& e, double s_ref_mm, const AxisArray& n, double d_mm)
+        : e_(e), d_(d_mm), rest_(n) {
+        if (e.kind != ElementKind::Arc) return;
+        AxisArray radial, tang;
+        frame(s_ref_mm, radial, tang);
+        for (int k = 0; k < kAxes; ++k) radial_ += n[k] * radial[k], tangential_ += n[k] * tang[k];
+        for (int k = 0; k < kAxes; ++k) rest_[k] -= radial_ * radial[k] + tangential_ * tang[k];
+    }
+
+    // The carried curve's point and unit tangent at the move's s.
+    void at(double s_mm, AxisArray& p, AxisArray& t) const {
+        CurvePoint cp;
+        evaluate_upto(e_, s_mm, 1, cp);
+        if (e_.kind != ElementKind::Arc) {
+            for (int k = 0; k < kAxes; ++k) p[k] = cp.p[k] + d_ * rest_[k];
+            t = cp.d1;
+            return;
+        }
+        AxisArray radial, tang;
+        frame(s_mm, radial, tang);
+        const double k1 = e_.sweep_rad / e_.length_mm;
+        double norm2 = 0;
+        for (int k = 0; k < kAxes; ++k) {
+            p[k] = cp.p[k] + d_ * (radial_ * radial[k] + tangential_ * tang[k] + rest_[k]);
+            t[k] = cp.d1[k] + d_ * k1 * (radial_ * tang[k] - tangential_ * radial[k]);
+            norm2 += t[k] * t[k];
+        }
+        const double inv = 1 / std::sqrt(norm2);
+        for (double& x : t) x *= inv;
+    }
+
+  private:
+    // The arc's unit radial and counter-clockwise tangent in its plane at s.
+    void frame(double s_mm, AxisArray& radial, AxisArray& tang) const {
+        const double th = e_.theta0_rad + e_.sweep_rad * std::clamp(s_mm / e_.length_mm, 0.0, 1.0);
+        const double cs = std::cos(th), sn = std::sin(th);
+        for (int k = 0; k < kAxes; ++k) {
+            radial[k] = cs * e_.a[k] + sn * e_.b[k];
+            tang[k] = -sn * e_.a[k] + cs * e_.b[k];
+        }
+    }
+
+    const Element& e_;
+    double d_;
+    double radial_ = 0, tangential_ = 0;  // arcs: n's parts along the radial and the tangent
+    AxisArray rest_;                      // the part of n that does not turn
+};
+
+}  // namespace
+
+// The offset corner where one or both moves are arcs or helices (no jerk limit). As between two
+// lines (offset_corner), the tool shifts d outwards off the incoming move, turns between the two
+// moves carried d outwards, and shifts back onto the outgoing move; here "carried outwards"
+// keeps the moves' curvature (CarriedMove), so a shift along an arc stays d from it. The corner
+// frame (the outward normals n1 and n2, the cut lp and the offset d) is the two lines' one for
+// the moves' tangents at the corner; the turn is the corner Bezier between the carried moves
+// (the parabola when both are lines) and each shift the cubic lane change between a move and
+// its carried copy, with the tangents of the curves they join. A move's curvature moves the
+// turn's deepest point, so the proofs decide (each piece within kOffsetProofShare of the
+// tolerance of the programmed moves, bezier_within); on failure the cut shrinks, and once it is
+// no longer than the one the Bezier blend inside the corner may take, the caller uses that.
+bool Planner::offset_arc_corner(const Piece& p, const Piece& next, double sin_angle,
+                                double l_speed_mm, Junction& jn) const {
+    const EndDerivs pe = end_derivs(p.geom, false), ns = start_derivs(next.geom, false);
+    const AxisArray &t1 = pe.tangent, &t2 = ns.tangent;
+    double cos_t = 0;
+    for (int k = 0; k < kAxes; ++k) cos_t += t1[k] * t2[k];
+    if (cos_t < kOffsetMinCos) return false;
+    const double sin_t = std::sqrt(std::max(0.0, 1 - cos_t * cos_t));
+    const double tol = p.tolerance_mm;
+    // A carried arc keeps at least half its radius (d <= tol).
+    for (const Element* e : {&p.geom, &next.geom})
+        if (e->kind == ElementKind::Arc && !(e->radius_mm > 2 * tol)) return false;
+    const AxisLimits& lim = cfg_.limits;
+    AxisArray n1, n2;
+    double turn = kInf, shift = 0;
+    for (int k = 0; k < kAxes; ++k) {
+        n1[k] = -(t2[k] - cos_t * t1[k]) / sin_t;
+        n2[k] = (t1[k] - cos_t * t2[k]) / sin_t;
+        double dt = std::fabs(t2[k] - t1[k]);
+        if (dt > 0) turn = std::min(turn, lim.acc_mm_s2[k] / dt);
+        shift = std::max(shift, std::max(std::fabs(n1[k]), std::fabs(n2[k])) / lim.acc_mm_s2[k]);
+    }
+    // Room for the shifts: a line before the corner may give all it has left after the corner
+    // at its start, an arc kMaxArcTrimShare of itself; the move after, what max_trim_mm allows.
+    const double L1 = p.geom.length_mm;
+    const double room1 = p.geom.kind == ElementKind::Line ? L1 - p.trim_start_mm
+                                                          : max_trim_mm(p.geom, p.trim_start_mm);
+    const double room2 = max_trim_mm(next.geom, 0);
+    // The Bezier blend inside the corner may cut this much: a shorter offset cut gains nothing.
+    const double l_inside = tol / (kParabolaDeviationPerL * sin_angle);
+    // The cuts for a turn cut lp, whose middle lies `share` tol inside the corner, from moves
+    // carried d = lp / 4 sin(angle) - share tol outwards (as between two lines).
+    struct Cuts {
+        double d, back, ls1, ls2, before_mm, after_mm;
+    };
+    auto cuts_for = [&](double lp, double share, Cuts& c) {
+        c.d = std::clamp(lp * kParabolaDeviationPerL * sin_angle - share * tol,
+                         kOffsetMinShare * tol, share * tol);
+        c.back = c.d * (1 - cos_t) / sin_t;  // d tan(angle / 2)
+        if (!(lp > c.back)) return false;
+        const double v_corner_mm_s = std::sqrt(2 * lp * turn);
+        const double ls =
+            kShiftSpeedFactor * v_corner_mm_s * std::sqrt(6 * c.d * shift / kShiftCentripetal);
+        c.ls1 = std::min(ls, room1 - (lp - c.back));
+        c.ls2 = std::min(ls, room2 - (lp - c.back));
+        const double keep = kShiftMinSpeedFactor / kShiftSpeedFactor;
+        if (c.ls1 < keep * ls || c.ls2 < keep * ls) return false;
+        c.before_mm = lp - c.back + c.ls1, c.after_mm = lp - c.back + c.ls2;
+        return true;
+    };
+    auto first_cut = [&](double share) {
+        return std::min(2 * share * tol / (kParabolaDeviationPerL * sin_angle),
+                        std::max(l_speed_mm, kSpeedCutFloor * tol));
+    };
+    // The path is cut into chords once, for the longest cuts tried; an arc's chords leave a
+    // slack (the arc's distance from them) that the shift and the turn must keep clear of, so
+    // both use that much less of the tolerance.
+    Cuts c;
+    if (!cuts_for(first_cut(kOffsetShare), kOffsetShare, c)) return false;
+    const CornerPath path = corner_path(p.geom, c.before_mm, next.geom, c.after_mm, tol);
+    double slack_mm = 0;
+    for (int i = 0; i < path.count; ++i) slack_mm = std::max(slack_mm, path.slack_mm[i]);
+    const double share = kOffsetShare - slack_mm / tol;
+    const double limit = kOffsetProofShare * tol;
+    double lp = first_cut(share);
+    for (int attempt = 0; attempt < kOffsetArcAttempts && lp > l_inside;
+         ++attempt, lp *= kOffsetArcShrink) {
+        if (!cuts_for(lp, share, c)) continue;
+        const CarriedMove q1(p.geom, L1, n1, c.d), q2(next.geom, 0, n2, c.d);
+        CurvePoint a0, b3;
+        evaluate_upto(p.geom, L1 - c.before_mm, 1, a0);
+        evaluate_upto(next.geom, c.after_mm, 1, b3);
+        AxisArray a3, ta3, b0, tb0;
+        q1.at(L1 - (lp - c.back), a3, ta3);
+        q2.at(lp - c.back, b0, tb0);
+        BezierPoints out, bend, in;
+        if (!corner_bezier_within(a3, ta3, b0, tb0, lp, path, limit, bend) ||
+            !corner_bezier_within(a0.p, a0.d1, a3, ta3, c.ls1 / 2, path, limit, out) ||
+            !corner_bezier_within(b0, tb0, b3.p, b3.d1, c.ls2 / 2, path, limit, in))
+            continue;
+        jn.set(kInf, false, c.before_mm, Blend::Offset);
+        jn.cut_after_mm = c.after_mm;
+        make_corner_bezier(out, path, jn.shift_out);
+        make_corner_bezier(bend, path, jn.curve);
+        make_corner_bezier(in, path, jn.shift_back);
+        return true;
+    }
+    return false;
+}
+
 void Planner::close_piece(Piece& p, Piece* next) {
     Junction& jn = junction_;
     if (next)
@@ -472,9 +649,11 @@ void Planner::close_piece(Piece& p, Piece* next) {
     else
         jn.set(0, false, 0);
     bool rough = p.rough_start || jn.rough;
-    // A Bezier corner starts where the move is cut (bezier_corner evaluated it there).
-    Element e = trimmed(p.geom, p.trim_start_mm, jn.blend_l_mm,
-                        jn.blend == Blend::Curve ? &jn.curve.origin : nullptr);
+    // A Bezier corner, or an offset corner's shift, starts where the move is cut (evaluated there).
+    const AxisArray* blend_start = jn.blend == Blend::Curve    ? &jn.curve.origin
+                                   : jn.blend == Blend::Offset ? &jn.shift_out.origin
+                                                               : nullptr;
+    Element e = trimmed(p.geom, p.trim_start_mm, jn.blend_l_mm, blend_start);
     // Only a line blended at both ends can vanish, and its junctions are smooth.
     if (e.length_mm > kMinLength_mm) add_item(e, p.feed_mm_s, jn.cap_mm_s, rough, p, p.rapid);
     if (!next) return;
@@ -490,10 +669,13 @@ void Planner::close_piece(Piece& p, Piece* next) {
     double turning = isolated ? kIsolatedBlendCentripetal : 0;
     switch (jn.blend) {
         case Blend::Offset: {
-            // The shift runs along the first move (its line and move; a single block stop
-            // comes at its end, within the tolerance); the turn belongs to the next move, as
-            // every blend does (synchronised outputs switch where it starts).
-            add_item(jn.shift_out, p.feed_mm_s, kInf, false, p, p.rapid, kShiftCentripetal);
+            // The shift runs along the first move at its feed. Off a line it keeps that line
+            // and move (a single block stop comes at its end, within the tolerance); off an arc
+            // it belongs to the next move, as the turn does, like every blend (synchronised
+            // outputs switch where it starts): the move is left where the tool leaves its path.
+            const Piece& shift_owner = p.geom.kind == ElementKind::Line ? p : *next;
+            add_item(jn.shift_out, p.feed_mm_s, kInf, false, shift_owner, p.rapid,
+                     kShiftCentripetal);
             add_item(jn.curve, feed, kInf, false, *next, rapid, kIsolatedBlendCentripetal);
             add_item(jn.shift_back, next->feed_mm_s, kInf, false, *next, next->rapid,
                      kShiftCentripetal);

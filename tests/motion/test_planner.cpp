@@ -381,6 +381,87 @@ TEST_P(ArcCorners, AreBlendedWithinToleranceAndLimits) {
 
 INSTANTIATE_TEST_SUITE_P(Jerk, ArcCorners, ::testing::Values(0.0, 1e9));
 
+// Without a jerk limit a right angle from a line into an arc is cut on the moves carried
+// outwards (offset_arc_corner), as between two lines: the tool shifts d outwards off the line
+// (y < 0), turns between the line moved to y = -d and the arc carried d along its radius
+// (radius R - d: the outward normal at the corner, +X, points to the arc's centre), and shifts
+// back onto the arc. The arc's chords (corner_path: n = ceil(dphi sqrt(R / (8 0.02 tol))) over
+// the longest cut) leave a slack R (dphi / n)^2 / 8 that both the offset and the turn keep clear
+// of: share = 0.99 - slack / tol instead of 0.99, lp = 8 share tol, d = share tol.
+TEST(Planner, LineIntoArcIsCutOnCarriedMovesWithoutJerkLimit) {
+    PlannerConfig cfg = uniform(100, 1000, 0);
+    const double tol = 0.01, r = 50;
+    test::Program prog;
+    prog.start = {-10, 0, 0};
+    // 0: along +X to the origin; 1: clockwise a quarter round (50, 0), leaving along +Y.
+    prog.segs.push_back(line_to({0, 0}, 50, tol, 0));
+    prog.segs.push_back(arc_to({r, r}, {r, 0}, -1, 50, tol, 1));
+    auto recs = plan(cfg, prog.segs, prog.start);
+    ASSERT_EQ(recs.size(), 5u);
+    for (int i = 1; i <= 3; ++i) ASSERT_EQ(recs[i].geom.kind, ElementKind::Bezier) << i;
+    ASSERT_EQ(recs[4].geom.kind, ElementKind::Arc);
+    EXPECT_EQ(recs[1].line, 0);
+    EXPECT_EQ(recs[2].line, 1);
+    EXPECT_EQ(recs[3].line, 1);
+    // The shift length for a turn cut lp with offset d: 3 x the turn's speed sqrt(2 lp A) on
+    // half the acceleration, the shift's second derivative peaking at 6 d / ls^2.
+    auto shift_mm = [](double lp, double d) {
+        return 3 * std::sqrt(2 * lp * 1000) * std::sqrt(6 * d / (0.5 * 1000));
+    };
+    const double lp0 = 8 * 0.99 * tol, d0 = 0.99 * tol;
+    const double dphi = (lp0 - d0 + shift_mm(lp0, d0)) / r;  // the arc's longest cut
+    const double chords = std::ceil(dphi * std::sqrt(r / (8 * 0.02 * tol)));
+    EXPECT_EQ(chords, 2);
+    const double slack = r * (dphi / chords) * (dphi / chords) / 8;
+    const double share = 0.99 - slack / tol;
+    const double lp = 8 * share * tol, d = share * tol, ls = shift_mm(lp, d);
+    // Each move loses lp + ls less d tan(45 deg).
+    EXPECT_NEAR(recs[0].geom.length_mm, 10 - (lp + ls - d), 1e-12);
+    EXPECT_NEAR(recs[4].geom.length_mm, r * std::numbers::pi / 2 - (lp + ls - d), 1e-9);
+    EXPECT_EQ(recs[4].geom.radius_mm, r);
+    EXPECT_EQ(sample(recs[4], recs[4].profile.duration_s).pos_mm, prog.segs[1].end_mm);
+    // The turn is nearly the two lines' parabola (the arc bends by lp / r = 0.0016 rad over
+    // it): it passes at sqrt(0.99 x 990 x 2 lp) within 1 %, 1.40 x the 8.855 mm/s of the blend
+    // inside the corner.
+    const double v = std::sqrt(0.99 * 990 * 2 * lp);
+    EXPECT_NEAR(recs[2].profile.peak_v_mm_s, v, 0.01 * v);
+    EXPECT_GT(recs[2].profile.peak_v_mm_s, 1.39 * std::sqrt(0.99 * 990 * 8 * tol));
+    // Within the tolerance (proved within 0.995 of it), reaching d outside the line on the
+    // first shift, and within every axis's 990 mm/s^2.
+    std::vector<Element> elems = test::programmed_elements(prog);
+    double worst = 0, lowest_y = 0, worst_acc = 0;
+    for (int i = 1; i <= 3; ++i) {
+        for (int j = 0; j <= 1000; ++j) {
+            MotionSample s = sample(recs[i], recs[i].profile.duration_s * j / 1000);
+            worst = std::max(worst, std::min(test::distance_to(elems[0], s.pos_mm),
+                                             test::distance_to(elems[1], s.pos_mm)));
+            lowest_y = std::min(lowest_y, s.pos_mm[1]);
+            for (int k = 0; k < 2; ++k) worst_acc = std::max(worst_acc, std::fabs(s.acc_mm_s2[k]));
+        }
+    }
+    EXPECT_LE(worst, 0.995 * tol);
+    EXPECT_NEAR(lowest_y, -d, 1e-6);
+    EXPECT_LE(worst_acc, 990 * (1 + 1e-9));
+}
+
+// Where the moves allow little more than the blend inside the corner (an arc into a line at
+// ex23's 10 mm/s feed, 1.13 x its 8.85 mm/s), the corner is the Bezier blend inside it: an
+// offset corner would gain about 0.4 ms there and cost several proofs against the arc's chords.
+TEST(Planner, ArcIntoLineAtALowFeedIsTheBlendInsideTheCorner) {
+    PlannerConfig cfg = uniform(100, 1000, 0);
+    const double tol = 0.01;
+    // A clockwise half circle from (-10, 0) round (-5, 0) ending along -Y, then a line along +X.
+    auto recs = plan(cfg, {arc_to({0, 0}, {-5, 0}, -1, 10, tol, 0), line_to({10, 0}, 10, tol, 1)},
+                     {-10, 0, 0});
+    ASSERT_EQ(recs.size(), 3u);
+    EXPECT_EQ(recs[1].geom.kind, ElementKind::Bezier);
+    // 0.995 tol inside a corner whose first side is an arc: a little less than the parabola's
+    // 4 x 0.995 tol from each move (bezier_corner shrinks the first guess until proved).
+    EXPECT_LE(recs[1].geom.length_mm, 2 * 4 * 0.995 * tol * (1 + 1e-12));
+    EXPECT_GT(recs[1].geom.length_mm, 0.9 * 2 * 4 * 0.995 * tol);
+    EXPECT_LT(recs[1].profile.peak_v_mm_s, 10);
+}
+
 // A run of small tangent arcs (alternating semicircles, end points rounded to 4 decimals as a
 // CAM program writes them) flows at the feed: the time is the length at feed plus one ramp up
 // and one down.

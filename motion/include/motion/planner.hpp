@@ -115,8 +115,8 @@ class Planner {
         Element curve;                  // Curve: the Bezier blend; Offset: the parabola
         double curve_end_cap_mm_s = 0;  // Curve: speed limit where the Bezier blend ends
         bool curve_end_rough = false;   // that junction is not smooth
-        // Blend::Offset (two lines, no jerk limit): shift out, parabola (curve), shift back;
-        // the first move loses blend_l_mm, the second cut_after_mm.
+        // Blend::Offset (no jerk limit): shift out, turn (curve: the parabola between two
+        // lines), shift back; the first move loses blend_l_mm, the second cut_after_mm.
         Element shift_out, shift_back;
         double cut_after_mm = 0;
 
@@ -135,6 +135,10 @@ class Planner {
     // false (as above) when that does not fit.
     bool offset_corner(const Piece& p, const Piece& next, double sin_angle, double l_speed_mm,
                        Junction& jn) const;
+    // The same for a corner where one or both moves are arcs or helices (the moves carried
+    // outwards with their curvature, see planner.cpp), or false when that does not fit.
+    bool offset_arc_corner(const Piece& p, const Piece& next, double sin_angle, double l_speed_mm,
+                           Junction& jn) const;
     // Highest speed at which a step between these second derivatives stays within the
     // junction share of one period's jerk (infinite without a jerk limit).
     double curvature_step_cap(const AxisArray& d2_before, const AxisArray& d2_after) const;
