@@ -1,7 +1,8 @@
-// Persistent settings and LinuxCNC tool tables: round trips, atomic replacement, and one test
-// per error message.
+// Persistent settings and LinuxCNC tool tables: round trips, atomic replacement, one test per
+// error message; and the lock a run holds on its settings files (in this process and another).
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -212,6 +213,60 @@ TEST(SettingsLock, TheLockFileIsNamedAfterTheSettingsFile) {
     EXPECT_EQ(lock.rfind("/L/m.var-", 0), 0u) << lock;
     EXPECT_EQ(lock.size(), std::string("/L/m.var-0123456789abcdef.lock").size()) << lock;
     EXPECT_NE(lock, SettingsFileLock::lock_file_of("/no-such-dir-iback2/m.var", "/L"));
+}
+
+// Another process holding the lock: the refusal names its process id, and once it has ended
+// (the kernel drops its lock) the file can be locked again.
+TEST(SettingsLock, AnotherProcessHoldingTheLockIsNamed) {
+    const cnc_test::ScratchDir scratch;
+    const std::string locks = (scratch.path() / "locks").string();
+    const std::string file = (scratch.path() / "m.var").string();
+    int locked[2];
+    int release[2];
+    ASSERT_EQ(::pipe(locked), 0);
+    ASSERT_EQ(::pipe(release), 0);
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+        // Holds the lock until the parent writes; _exit so nothing of the test runs twice.
+        char c = 0;
+        try {
+            const SettingsFileLock held(file, locks);
+            if (::write(locked[1], "l", 1) != 1) ::_exit(2);
+            if (::read(release[0], &c, 1) != 1) ::_exit(3);
+        } catch (...) {
+            ::_exit(1);
+        }
+        ::_exit(0);
+    }
+    char c = 0;
+    ASSERT_EQ(::read(locked[0], &c, 1), 1);
+    EXPECT_EQ(error_of_lock(file, locks),
+              fmt::format("{}: settings file in use by another run (pid {}); two runs on the "
+                          "same settings would overwrite each other's changes",
+                          file, child));
+    ASSERT_EQ(::write(release[1], "r", 1), 1);
+    int status = 0;
+    ASSERT_EQ(::waitpid(child, &status, 0), child);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;
+    EXPECT_EQ(error_of_lock(file, locks), "no error");
+    for (int fd : {locked[0], locked[1], release[0], release[1]}) ::close(fd);
+}
+
+// A lock file that outlived its holder (the process was killed before removing it) keeps
+// nobody out: the kernel dropped the lock with the process.
+TEST(SettingsLock, ALeftOverLockFileIsTakenOver) {
+    const cnc_test::ScratchDir scratch;
+    const std::string locks = (scratch.path() / "locks").string();
+    const std::string file = (scratch.path() / "m.var").string();
+    fs::create_directories(locks);
+    const std::string lock_file = SettingsFileLock::lock_file_of(file, locks);
+    std::ofstream(lock_file) << "999999999\n";
+    {
+        const SettingsFileLock lock(file, locks);
+        EXPECT_EQ(cnc_test::slurp(lock_file), fmt::format("{}\n", ::getpid()));
+    }
+    EXPECT_FALSE(fs::exists(lock_file));
 }
 
 }  // namespace
