@@ -66,9 +66,9 @@ inline interp::Settings load_state(const StateFiles& files) {
 }
 
 // Writes the parts of the settings that changed since the last write (or the load): the tool
-// table when it is kept (edited in place, so a hand-written table keeps its other words, comments
-// and order: interp::update_linuxcnc_tool_table), the rest into the settings file (the tools too
-// when no tool table is).
+// table when it is kept, the rest into the settings file (the tools too when no tool table is).
+// Both are edited in place, so what a person wrote in them stays but for the changed values
+// (interp::update_linuxcnc_tool_table, interp::update_settings_text).
 class StateSaver {
   public:
     StateSaver(StateFiles files, interp::Settings loaded)
@@ -88,12 +88,12 @@ class StateSaver {
             (!tools_here || s.tools == saved_.tools))
             return;
         if (tools_here) {
-            interp::save_settings_atomic(files_.settings, s);
+            interp::save_settings_atomic(files_.settings, s, files_.settings_seed);
         } else {
             interp::Settings rest;
             rest.offsets = s.offsets;
             rest.params = s.params;
-            interp::save_settings_atomic(files_.settings, rest);
+            interp::save_settings_atomic(files_.settings, rest, files_.settings_seed);
         }
         saved_.offsets = s.offsets;
         saved_.params = s.params;

@@ -152,6 +152,29 @@ TEST(CncRunSettings, AHandWrittenToolTableKeepsEverythingButTheChangedValue) {
     expect_next_run_ends_at(m, "G90 G21\nT2 M6\nG43 H2 G0 Z-60\nM30\n", 0, 0, -23.75);
 }
 
+// A settings file a person wrote keeps its comments, order and spacing: G922 rewrites only the
+// G54 line's words (before its comment), G92 adds the g92 line the file lacked at its end.
+TEST(CncRunSettings, AHandWrittenSettingsFileKeepsEverythingButTheChangedEntry) {
+    const Machine m;
+    fs::create_directories(m.settings_dir());
+    std::ofstream(m.file("mill.var")) << "# mill 3, set up by hand\n"
+                                         "\n"
+                                         "wcs 2 100 50 0 0 0 0  # vice\n"
+                                         "wcs 1   5 5 0 0 0 0  # plate\n";
+    const RunResult set = m.run("set.ngc", "G90 G21\nG922 P0 X10 Y20 Z-5\nG92 X-30\nM30\n");
+    ASSERT_EQ(set.exit_code, 0) << set.err << set.out;
+    // why: G92 X-30 at machine X0 under G54 (X10) makes work X-30 of machine X0: the shift is
+    // 0 - 10 - (-30) = +20.
+    EXPECT_EQ(slurp(m.file("mill.var")),
+              "# mill 3, set up by hand\n"
+              "\n"
+              "wcs 2 100 50 0 0 0 0  # vice\n"
+              "wcs 1 10 20 -5 0 0 0  # plate\n"
+              "g92 20 0 0 0 0 0\n");
+    // why: work X0 Y0 Z0 under G54 + G92 is machine X10+20 Y20 Z-5.
+    expect_next_run_ends_at(m, "G90 G21\nG54 G0 X0 Y0 Z0\nM30\n", 30, 20, -5);
+}
+
 TEST(CncRunSettings, BadSettingsLineRefusesToStart) {
     const Machine m;
     fs::create_directories(m.settings_dir());

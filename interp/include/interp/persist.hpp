@@ -31,9 +31,21 @@ struct Settings {
 // cannot read file: cause"; nothing is changed on disk.
 Settings load_settings(const std::string& path);
 Settings parse_settings(const std::string& text, const std::string& name);
+// A new settings file: a header comment, then every entry in the order above.
 std::string format_settings(const Settings& s);
-// Throws std::runtime_error with the path and errno text on failure; the old file stays intact.
-void save_settings_atomic(const std::string& path, const Settings& s);
+// `old_text` (a file parse_settings accepts, `name` in its errors) rewritten to hold `s`, so
+// that what a person wrote in it survives: every line stays as it was (comments, blank lines,
+// order, spacing, line endings) except an entry whose value `s` changes, whose words are written
+// anew in format_settings' form before the line's own comment. Entries the file lacks are
+// appended in format_settings' order (offsets only when not at their default); a line for an
+// entry `s` lacks (a tool, while a tool table holds the tools) stays. An empty `old_text` gives
+// format_settings(s). Throws interp::Error "name:line:col: cause" for a bad line.
+std::string update_settings_text(const std::string& old_text, const Settings& s,
+                                 const std::string& name);
+// Writes `s` into `path` as update_settings_text of the file there now or, while there is none,
+// of `seed` (none: format_settings). Throws std::runtime_error with the path and errno text on
+// failure, interp::Error for a file on disk that no longer reads; the old file stays intact.
+void save_settings_atomic(const std::string& path, const Settings& s, const std::string& seed = "");
 
 // Writes `t` into the LinuxCNC .tbl file `path` as update_linuxcnc_tool_table of the table the
 // file holds now or, while it does not exist, of `seed` (none: a new table), so that the words,

@@ -14,11 +14,15 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <set>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "interp/block.hpp"
+#include "text_lines.hpp"
 
 namespace interp {
 
@@ -167,16 +171,76 @@ Settings load_settings(const std::string& path) {
     return parse_settings(ss.str(), path);
 }
 
+namespace {
+
+// Every entry of `s` as the file writes it, by its key ("wcs 3", "common", "g92", "tool 7",
+// "param NAME"), in the file's order.
+std::vector<std::pair<std::string, std::string>> entry_lines(const Settings& s) {
+    std::vector<std::pair<std::string, std::string>> out;
+    for (int i = 0; i < kWorkSystems; ++i)
+        out.emplace_back(fmt::format("wcs {}", i + 1),
+                         fmt::format("wcs {}{}", i + 1, axes_line(s.offsets.wcs[i])));
+    out.emplace_back("common", "common" + axes_line(s.offsets.common));
+    out.emplace_back("g92", "g92" + axes_line(s.offsets.g92));
+    for (const auto& [n, e] : s.tools.entries())
+        out.emplace_back(fmt::format("tool {}", n),
+                         fmt::format("tool {} {} {} {} {}", n, e.offset_mm[0], e.offset_mm[1],
+                                     e.offset_mm[2], e.diameter_mm));
+    for (const auto& [k, v] : s.params)
+        out.emplace_back("param " + k, fmt::format("param {} {}", k, v));
+    return out;
+}
+
+// The key of a line parse_settings has accepted (as entry_lines names it).
+std::string key_of(const std::vector<Token>& toks) {
+    const std::string& kind = toks.front().text;
+    if (kind == "wcs" || kind == "tool") {
+        double n = 0;
+        std::from_chars(toks[1].text.data(), toks[1].text.data() + toks[1].text.size(), n);
+        return fmt::format("{} {}", kind, static_cast<int>(n));
+    }
+    if (kind == "param") return "param " + toks[1].text;
+    return kind;
+}
+
+}  // namespace
+
 std::string format_settings(const Settings& s) {
     std::string out = "# cnc interpreter persistent settings (mm)\n";
-    for (int i = 0; i < kWorkSystems; ++i)
-        out += fmt::format("wcs {}{}\n", i + 1, axes_line(s.offsets.wcs[i]));
-    out += "common" + axes_line(s.offsets.common) + "\n";
-    out += "g92" + axes_line(s.offsets.g92) + "\n";
-    for (const auto& [n, e] : s.tools.entries())
-        out += fmt::format("tool {} {} {} {} {}\n", n, e.offset_mm[0], e.offset_mm[1],
-                           e.offset_mm[2], e.diameter_mm);
-    for (const auto& [k, v] : s.params) out += fmt::format("param {} {}\n", k, v);
+    for (const auto& [key, line] : entry_lines(s)) out += line + "\n";
+    return out;
+}
+
+std::string update_settings_text(const std::string& old_text, const Settings& s,
+                                 const std::string& name) {
+    if (old_text.empty()) return format_settings(s);
+    std::map<std::string, std::string> was;
+    for (auto& [key, line] : entry_lines(parse_settings(old_text, name))) was[key] = line;
+    const auto now_lines = entry_lines(s);
+    const std::map<std::string, std::string> now(now_lines.begin(), now_lines.end());
+    std::string out;
+    std::set<std::string> listed;
+    text_lines::for_each(old_text, [&](std::string line, const std::string& ending) {
+        const auto toks = split(line.substr(0, line.find('#')));
+        if (!toks.empty()) {
+            const std::string key = key_of(toks);
+            listed.insert(key);
+            // A line for an entry `s` lacks (the tools, while a tool table holds them) stays.
+            if (auto it = now.find(key); it != now.end() && was.at(key) != it->second) {
+                const std::size_t begin = static_cast<std::size_t>(toks.front().col) - 1;
+                const std::size_t end =
+                    static_cast<std::size_t>(toks.back().col) - 1 + toks.back().text.size();
+                line.replace(begin, end - begin, it->second);
+            }
+        }
+        out += line + ending;
+    });
+    const std::string ending = text_lines::ending_of(old_text);
+    for (const auto& [key, line] : now_lines) {
+        auto it = was.find(key);
+        if (!listed.count(key) && (it == was.end() || it->second != line))
+            text_lines::append_line(out, line, ending);
+    }
     return out;
 }
 
@@ -214,40 +278,38 @@ void write_file_atomic(const std::string& path, const std::string& text, const c
     }
 }
 
-}  // namespace
-
-void save_settings_atomic(const std::string& path, const Settings& s) {
-    write_file_atomic(path, format_settings(s), "settings");
-}
-
-namespace {
-
-// The table a save starts from: `path` once it exists, else `seed`, else none ("").
-struct TableText {
+// The file a save edits: `path` once it exists, else `seed`, else none (empty). A directory in
+// the way of `path` gives none too, so that the save fails where it writes, naming it.
+struct SavedText {
     std::string file;
     std::string text;
 };
 
-TableText tool_table_base(const std::string& path, const std::string& seed) {
+SavedText saved_text(const std::string& path, const std::string& seed, const char* what) {
     std::error_code ec;
     std::string from = path;
     if (!std::filesystem::exists(path, ec)) {
         if (seed.empty() || !std::filesystem::exists(seed, ec)) return {};
         from = seed;
     }
-    if (std::filesystem::is_directory(from, ec)) sys_fail("cannot read tool table", from, EISDIR);
+    if (std::filesystem::is_directory(from, ec)) return {};
     std::ifstream f(from, std::ios::binary);
-    if (!f) sys_fail("cannot read tool table", from, errno);
+    if (!f) sys_fail(fmt::format("cannot read {} file", what), from, errno);
     std::ostringstream ss;
     ss << f.rdbuf();
-    if (f.bad()) sys_fail("cannot read tool table", from, EIO);
+    if (f.bad()) sys_fail(fmt::format("cannot read {} file", what), from, EIO);
     return {from, ss.str()};
 }
 
 }  // namespace
 
+void save_settings_atomic(const std::string& path, const Settings& s, const std::string& seed) {
+    const SavedText base = saved_text(path, seed, "settings");
+    write_file_atomic(path, update_settings_text(base.text, s, base.file), "settings");
+}
+
 void save_tool_table_atomic(const std::string& path, const ToolTable& t, const std::string& seed) {
-    const TableText base = tool_table_base(path, seed);
+    const SavedText base = saved_text(path, seed, "tool table");
     write_file_atomic(path, update_linuxcnc_tool_table(base.text, t, base.file), "tool table");
 }
 

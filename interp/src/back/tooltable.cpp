@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "interp/block.hpp"
+#include "text_lines.hpp"
 
 namespace interp {
 
@@ -130,31 +131,20 @@ ParsedLine parse_line(const std::string& line, std::string_view name, int line_n
     return p;
 }
 
-// Calls `each(line, ending, parsed)` for every line of `text`; `ending` is what ended the line
-// ("\r\n", "\n", or "" for a last line without one). Checks the whole table first, so that
-// nothing is written from a table the reader would refuse.
+// Calls `each(line, ending, parsed)` for every line of `text` (text_lines::for_each). Checks
+// the whole table first, so that nothing is written from a table the reader would refuse.
 template <typename Each>
 void for_each_line(const std::string& text, std::string_view name, Each each) {
     std::set<int> tools;
-    std::size_t start = 0;
     int line_no = 0;
-    while (start < text.size()) {
-        const std::size_t nl = text.find('\n', start);
-        const std::size_t end = nl == std::string::npos ? text.size() : nl;
-        std::string line = text.substr(start, end - start);
-        std::string ending = nl == std::string::npos ? "" : "\n";
-        if (!line.empty() && line.back() == '\r') {
-            line.pop_back();
-            ending.insert(ending.begin(), '\r');
-        }
+    text_lines::for_each(text, [&](const std::string& line, const std::string& ending) {
         ++line_no;
         ParsedLine p = parse_line(line, name, line_no);
         if (p.tool && !tools.insert(*p.tool).second)
             throw Error(SourceLoc{name, line_no, 1},
                         "tool table: tool " + std::to_string(*p.tool) + " listed twice");
         each(line, ending, p);
-        start = end == text.size() ? end : end + 1;
-    }
+    });
 }
 
 // Replaces `erase` characters at `at` with `text`.
@@ -240,15 +230,9 @@ std::string update_linuxcnc_tool_table(const std::string& old_text, const ToolTa
                       out += ending;
                       if (p.tool) listed.insert(*p.tool);
                   });
-    // New lines end as the file's first line does (a table written on Windows keeps "\r\n").
-    const std::size_t nl = old_text.find('\n');
-    const std::string ending =
-        nl != std::string::npos && nl > 0 && old_text[nl - 1] == '\r' ? "\r\n" : "\n";
-    for (const auto& [n, e] : t.entries()) {
-        if (listed.count(n)) continue;
-        if (!out.empty() && out.back() != '\n') out += ending;
-        out += new_line(n, e) + ending;
-    }
+    const std::string ending = text_lines::ending_of(old_text);
+    for (const auto& [n, e] : t.entries())
+        if (!listed.count(n)) text_lines::append_line(out, new_line(n, e), ending);
     return out;
 }
 

@@ -164,6 +164,80 @@ TEST(ToolTable, MissingFileIsAnError) {
     }
 }
 
+// A settings file a person wrote: comments, blank lines, its own order and spacing.
+const std::string kHandSettings =
+    "# mill 3 - offsets measured 2026-11-02\n"
+    "\n"
+    "g92 0 0 0 0 0 0\n"
+    "wcs 2   1.5 0 0 0 0 0   # fixture B\n"
+    "  wcs 1 10 20 -5 0 0 0\n"
+    "param FIXEDCALI_REC -40.25 # contact Z\n"
+    "tool 3 0 0 45 6\n";
+
+TEST(SettingsRewrite, UnchangedSettingsKeepEveryByte) {
+    const Settings s = parse_settings(kHandSettings, "m.var");
+    EXPECT_EQ(update_settings_text(kHandSettings, s, "m.var"), kHandSettings);
+    EXPECT_EQ(s.offsets.wcs[1][0], 1.5);
+    EXPECT_EQ(s.offsets.wcs[0][2], -5);
+}
+
+// Expected: kHandSettings with the changed entries' words written anew (by hand).
+TEST(SettingsRewrite, OnlyTheChangedEntriesAreWrittenAnew) {
+    Settings s = parse_settings(kHandSettings, "m.var");
+    s.offsets.wcs[1][0] = 7;
+    s.offsets.wcs[0][1] = 21;
+    EXPECT_EQ(update_settings_text(kHandSettings, s, "m.var"),
+              "# mill 3 - offsets measured 2026-11-02\n"
+              "\n"
+              "g92 0 0 0 0 0 0\n"
+              "wcs 2 7 0 0 0 0 0   # fixture B\n"
+              "  wcs 1 10 21 -5 0 0 0\n"
+              "param FIXEDCALI_REC -40.25 # contact Z\n"
+              "tool 3 0 0 45 6\n");
+}
+
+// What the file lacks goes at its end; an offset the file lacks only when it is not 0; a line
+// for something the new settings lack (the tools, kept in a tool table) stays.
+TEST(SettingsRewrite, NewEntriesAreAppendedAndLinesForOthersStay) {
+    const std::string text = "# offsets\r\nwcs 1 1 2 3 0 0 0\r\ntool 3 0 0 45 6";
+    Settings s = parse_settings(text, "m.var");
+    s.tools = ToolTable{};
+    s.offsets.common[2] = -0.5;
+    s.params["FIXEDCALI_REC"] = 12.5;
+    EXPECT_EQ(update_settings_text(text, s, "m.var"),
+              "# offsets\r\nwcs 1 1 2 3 0 0 0\r\ntool 3 0 0 45 6\r\n"
+              "common 0 0 -0.5 0 0 0\r\nparam FIXEDCALI_REC 12.5\r\n");
+    EXPECT_EQ(update_settings_text("", s, "m.var"), format_settings(s));
+}
+
+TEST(SettingsRewrite, ABadFileIsRefusedWithItsLine) {
+    try {
+        update_settings_text("wcs 1 0 0 0 0 0 0\nwcs 9 0 0 0 0 0 0\n", Settings{}, "m.var");
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()), "m.var:2:5: settings: '9' must be an integer in 1..6");
+    }
+}
+
+// The first save edits the seed's text (the INI's own file), the next ones the file itself.
+TEST(SettingsRewrite, SaveEditsTheFileOrItsSeed) {
+    const cnc_test::ScratchDir scratch;
+    const std::string seed = (scratch.path() / "seed.var").string();
+    const std::string file = (scratch.path() / "m.var").string();
+    std::ofstream(seed) << kHandSettings;
+    Settings s = parse_settings(kHandSettings, "m.var");
+    s.offsets.g92[0] = 2.5;
+    save_settings_atomic(file, s, seed);
+    std::string expected = kHandSettings;
+    expected.replace(expected.find("g92 0 0"), 7, "g92 2.5 0");
+    EXPECT_EQ(cnc_test::slurp(file), expected);
+    EXPECT_EQ(cnc_test::slurp(seed), kHandSettings);
+    s.params["FIXEDCALI_REC"] = 1;
+    save_settings_atomic(file, s, seed);
+    expected.replace(expected.find("-40.25 #"), 8, "1 #");
+    EXPECT_EQ(cnc_test::slurp(file), expected);
+}
+
 std::string error_of_lock(const std::string& path, const std::string& lock_dir) {
     try {
         SettingsFileLock lock(path, lock_dir);
