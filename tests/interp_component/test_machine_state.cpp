@@ -169,4 +169,23 @@ TEST_F(Folder, AHandWrittenToolTableKeepsEverythingButTheChangedValue) {
               "T2 P2 Z20 D0\n");
 }
 
+// A tool only the settings file lists (the INI named no tool table before) is not lost when an
+// offset is saved: its line stays until a tool save carries it into the table.
+TEST_F(Folder, AnOffsetSaveKeepsAToolOnlyTheSettingsFileLists) {
+    StateFiles f;
+    f.settings = (dir_ / "m.var").string();
+    f.tool_table = (dir_ / "t.tbl").string();
+    std::ofstream(f.settings) << "tool 2 0 0 22 0\n";
+    std::ofstream(f.tool_table) << "T1 P1 Z40 D6\n";
+    interp::Settings s = machine_program::load_state(f);
+    machine_program::StateSaver saver(f, s);
+    s.offsets.g92[0] = 1;
+    saver.save(s);
+    EXPECT_EQ(cnc_test::slurp(f.settings), "tool 2 0 0 22 0\ng92 1 0 0 0 0 0\n");
+    ASSERT_NE(machine_program::load_state(f).tools.find(2), nullptr);
+    s.tools.at(1).offset_mm[2] = 41;
+    saver.save(s);
+    EXPECT_EQ(cnc_test::slurp(f.tool_table), "T1 P1 Z41 D6\nT2 P2 Z22 D0\n");
+}
+
 }  // namespace
