@@ -163,15 +163,15 @@ void merge_outputs(std::uint64_t& set, std::uint64_t& clear, std::uint64_t set_b
 }  // namespace
 
 void ProgramFeeder::collect(const motion::PreparedSegment* extra) {
-    motion::PreparedSegment rec;
-    while (planner_->pop(rec)) {
+    // Copied once, straight into the outbox (pop() would copy each record twice).
+    while (const motion::PreparedSegment* ready = planner_->pop_ref()) {
+        motion::PreparedSegment& rec = outbox_.emplace_back(*ready);
         while (!pending_outputs_.empty() && rec.move_id >= pending_outputs_.front().from_move_id) {
             const PendingOutputs& p = pending_outputs_.front();
             merge_outputs(rec.dout_set, rec.dout_clear, p.set, p.clear);
             rec.message = std::max(rec.message, p.message);
             pending_outputs_.pop_front();
         }
-        outbox_.push_back(rec);
     }
     if (extra) outbox_.push_back(*extra);
 }

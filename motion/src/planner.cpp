@@ -927,8 +927,9 @@ void Planner::emit(const Item& it, MakeProfile&& make_profile) {
 }
 
 bool Planner::pop(PreparedSegment& out) noexcept {
-    if (out_head_ == out_.size()) return false;
-    out = out_[out_head_++];
+    const PreparedSegment* rec = pop_ref();
+    if (!rec) return false;
+    out = *rec;
     return true;
 }
 

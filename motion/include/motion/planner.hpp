@@ -64,6 +64,12 @@ class Planner {
     void reset(const AxisArray& start_mm);
 
     std::size_t ready() const noexcept { return out_.size() - out_head_; }
+    // The next ready record by reference (nullptr when none is ready), for a consumer that
+    // would copy it anyway: pop() copies all ~950 bytes of it once more. The record stays
+    // valid until the next push(), finish() or reset().
+    const PreparedSegment* pop_ref() noexcept {
+        return out_head_ == out_.size() ? nullptr : &out_[out_head_++];
+    }
     bool pop(PreparedSegment& out) noexcept;
     // Copies up to out.size() ready records; returns how many.
     std::size_t take(std::span<PreparedSegment> out) noexcept;
