@@ -458,6 +458,12 @@ namespace {
 constexpr double kChordSlackShare = 0.02;
 // Halvings of a blend before bezier_within gives up (2^6 pieces).
 constexpr int kMaxSplitDepth = 6;
+// Proof::surely_near_chord: a whole hull counts as proved when its control points lie within
+// (1 - 1e-5) of a chord's room (squared: 1 - 2e-5 <= (1 - 1e-5)^2) and no coordinate exceeds
+// 1e7 times that room. The rounding argument there needs 300 u S <= 1e-5 room (u = 2^-53),
+// that is S <= 3e8 room: 1e7 leaves a factor 30.
+constexpr double kWholeHullRoom2Share = 1 - 2e-5;
+constexpr double kWholeHullScalePerRoom = 1e7;
 
 // Sets moving[k] for every axis e changes anywhere (and leaves the others as they were).
 // The bits of x without its sign: 0 exactly when x == 0 (+0 or -0), nonzero for NaN too.
@@ -573,6 +579,38 @@ struct Proof {
                chord_dist2(c, q[1]) <= r2 && chord_dist2(c, q[2]) <= r2;
     }
 
+    // Whether prove() would succeed on the piece q (in the path's axes only, with
+    // still_axes2 == 0) because all of it lies near chord c: every control point within
+    // (1 - 1e-5) of the room, and every coordinate S of the points, and |from| + |dir| of the
+    // chord, within 1e7 times the room. Rounding argument (f: the exact distance from the
+    // chord's segment, convex and 1-Lipschitz; u = 2^-53; n <= 9 axes):
+    //  1. chord_dist2 computes x^ = q - a - t^ d for some t^ in [0, 1] with |x^_k - x_k| <=
+    //     6 u S per axis, so f(q) <= |x| <= sqrt(r^) (1 + 6 u) + 20 u S: each control point
+    //     is within R (1 + 6 u) + 20 u S, R^2 = (1 - 2e-5) room^2.
+    //  2. prove() splits once and proves both halves; their control points are convex
+    //     combinations of these (f convex: within the same bound) computed with 3 roundings of
+    //     at most u S each: 9 u S more.
+    //  3. For any point, t^ is within D = 23 u |q - a| / |d| of the exact (clamped) minimiser,
+    //     which adds at most sqrt(3) |d| D <= 240 u S to |x|; with step 1's 20 u S and the
+    //     sum's rounding, chord_dist2's sqrt(r^) <= (f + 260 u S) (1 + 5 u).
+    //  Together sqrt(r^) <= R (1 + 12 u) + 300 u S <= room (1 - 1e-5 + 13 u) + 300 u S, below
+    //  room (1 - u) (which r2 = room * room is at least) whenever 300 u S < 1e-5 room.
+    //  The halves' midpoint passes beyond_reach() on this chord for the same reason.
+    // hull_scale: the largest |coordinate| of q's points.
+    bool surely_near_chord(int c, const Hull& q, double hull_scale) const {
+        const double r2 = room2(c);
+        if (r2 < 0 || still_axes2 != 0 || dims != path.dims) return false;
+        const double tight2 = r2 * kWholeHullRoom2Share;
+        if (!(chord_dist2(c, q[3]) <= tight2 && chord_dist2(c, q[0]) <= tight2 &&
+              chord_dist2(c, q[1]) <= tight2 && chord_dist2(c, q[2]) <= tight2))
+            return false;
+        const AxisArray &a = path.from[c], &d = path.dir[c];
+        const int n = PathDims > 0 ? PathDims : path.dims;
+        double scale = hull_scale;
+        for (int k = 0; k < n; ++k) scale = std::max(scale, std::fabs(a[k]) + std::fabs(d[k]));
+        return scale * scale <= kWholeHullScalePerRoom * kWholeHullScalePerRoom * r2;
+    }
+
     // Tries the chord that held the previous piece first: the pieces follow the path in order.
     bool hull_near_path(const Hull& q, int& hint) const {
         for (int c = hint; c < path.count; ++c)
@@ -643,25 +681,39 @@ bool prove(const Proof<PathDims, Dims>& proof, Hull& piece, int dims) {
     }
 }
 
+// Whole::Try: first the whole piece on each chord (Proof::surely_near_chord), for a Bezier
+// that may lie along one move, such as a lane change (shift_bezier_within): when that holds,
+// prove() would succeed, so the result is the same, sooner.
+enum class Whole : bool { Skip, Try };
+
 template <int PathDims, int Dims = 0>
-bool prove_hull(const CornerPath& path, double limit_mm, double still_axes2, Hull& piece,
-                int dims) {
-    return prove(Proof<PathDims, Dims>{path, limit_mm, still_axes2, dims}, piece, dims);
+bool prove_hull(const CornerPath& path, double limit_mm, double still_axes2, Hull& piece, int dims,
+                Whole whole) {
+    const Proof<PathDims, Dims> proof{path, limit_mm, still_axes2, dims};
+    if (whole == Whole::Try) {
+        const int n = Dims > 0 ? Dims : dims;
+        double scale = 0;
+        for (const AxisArray& point : piece)
+            for (int k = 0; k < n; ++k) scale = std::max(scale, std::fabs(point[k]));
+        for (int c = 0; c < path.count; ++c)
+            if (proof.surely_near_chord(c, piece, scale)) return true;
+    }
+    return prove(proof, piece, dims);
 }
 
 // bezier_within for a hull in the path's axes (then the blend's own), with still_axes2 the
 // squared distance in the rest.
-bool hull_within(const CornerPath& path, double limit_mm, double still_axes2, Hull& piece,
-                 int dims) {
+bool hull_within(const CornerPath& path, double limit_mm, double still_axes2, Hull& piece, int dims,
+                 Whole whole = Whole::Skip) {
     switch (path.dims) {
         case 2:
-            return dims == 2 ? prove_hull<2, 2>(path, limit_mm, still_axes2, piece, dims)
-                             : prove_hull<2>(path, limit_mm, still_axes2, piece, dims);
+            return dims == 2 ? prove_hull<2, 2>(path, limit_mm, still_axes2, piece, dims, whole)
+                             : prove_hull<2>(path, limit_mm, still_axes2, piece, dims, whole);
         case 3:
-            return dims == 3 ? prove_hull<3, 3>(path, limit_mm, still_axes2, piece, dims)
-                             : prove_hull<3>(path, limit_mm, still_axes2, piece, dims);
+            return dims == 3 ? prove_hull<3, 3>(path, limit_mm, still_axes2, piece, dims, whole)
+                             : prove_hull<3>(path, limit_mm, still_axes2, piece, dims, whole);
         default:
-            return prove_hull<0>(path, limit_mm, still_axes2, piece, dims);
+            return prove_hull<0>(path, limit_mm, still_axes2, piece, dims, whole);
     }
 }
 
@@ -736,9 +788,12 @@ bool corner_piece_within(const BezierPoints& b, const CornerPath& path, double l
     return hull_within(path, limit_mm, 0, piece, path.dims);
 }
 
-bool corner_bezier_within(const AxisArray& p0, const AxisArray& t1, const AxisArray& p3,
+namespace {
+
+// corner_bezier_within and shift_bezier_within.
+bool bezier_points_within(const AxisArray& p0, const AxisArray& t1, const AxisArray& p3,
                           const AxisArray& t2, double l_mm, const CornerPath& path,
-                          double limit_mm, BezierPoints& out) noexcept {
+                          double limit_mm, BezierPoints& out, Whole whole) {
     // At rest in the still axes (p0 = p3 = fixed, t1 = t2 = 0 there): d = p3 - p0 and t1 + t2
     // are +-0, which leave the sums bit for bit as they are; p1 = p0 + h t1 and p2 = p3 - h t2
     // equal p0 and p3, so bezier_within would count those axes as still, at distance
@@ -763,9 +818,23 @@ bool corner_bezier_within(const AxisArray& p0, const AxisArray& t1, const AxisAr
         piece[0][j] = p0[k], piece[1][j] = p0[k] + h * t1[k];
         piece[2][j] = p3[k] - h * t2[k], piece[3][j] = p3[k];
     }
-    if (!hull_within(path, limit_mm, 0, piece, path.dims)) return false;
+    if (!hull_within(path, limit_mm, 0, piece, path.dims, whole)) return false;
     set_corner_bezier(p0, t1, p3, t2, h, out);
     return true;
+}
+
+}  // namespace
+
+bool corner_bezier_within(const AxisArray& p0, const AxisArray& t1, const AxisArray& p3,
+                          const AxisArray& t2, double l_mm, const CornerPath& path,
+                          double limit_mm, BezierPoints& out) noexcept {
+    return bezier_points_within(p0, t1, p3, t2, l_mm, path, limit_mm, out, Whole::Skip);
+}
+
+bool shift_bezier_within(const AxisArray& p0, const AxisArray& t1, const AxisArray& p3,
+                         const AxisArray& t2, double l_mm, const CornerPath& path, double limit_mm,
+                         BezierPoints& out) noexcept {
+    return bezier_points_within(p0, t1, p3, t2, l_mm, path, limit_mm, out, Whole::Try);
 }
 
 }  // namespace motion

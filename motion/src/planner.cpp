@@ -459,13 +459,13 @@ bool Planner::offset_corner(const Piece& p, const Piece& next, double sin_angle,
     }
     // Every piece is proved within the tolerance of the programmed lines. In the axes neither
     // line moves, all their points equal the corner's (the terms added to it there are +-0), so
-    // the proofs run in the lines' axes (corner_bezier_within, corner_piece_within). The
+    // the proofs run in the lines' axes (shift_bezier_within, corner_piece_within). The
     // parabola's points are make_parabola(c2, t1, t2, lp)'s.
     const CornerPath path = corner_path(p.geom, cut_before_mm, next.geom, cut_after_mm, tol);
     const double limit = kOffsetProofShare * tol;
     BezierPoints out, par, in;
-    if (!corner_bezier_within(a0, t1, a3, t1, ls1 / 2, path, limit, out) ||
-        !corner_bezier_within(b0, t2, b3, t2, ls2 / 2, path, limit, in))
+    if (!shift_bezier_within(a0, t1, a3, t1, ls1 / 2, path, limit, out) ||
+        !shift_bezier_within(b0, t2, b3, t2, ls2 / 2, path, limit, in))
         return false;
     for (int k = 0; k < kAxes; ++k) {
         par.p0[k] = c2[k] - lp * t1[k];

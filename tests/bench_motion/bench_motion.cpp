@@ -133,7 +133,8 @@ double thread_cpu_s() {
     Planner planner(cfg, prog.start_mm);
     for (const PathSegment& seg : prog.segments) {
         planner.push(seg);
-        while (const PreparedSegment* rec = planner.pop_ref()) duration_s += rec->profile.duration_s;
+        while (const PreparedSegment* rec = planner.pop_ref())
+            duration_s += rec->profile.duration_s;
     }
     planner.finish();
     while (const PreparedSegment* rec = planner.pop_ref()) duration_s += rec->profile.duration_s;

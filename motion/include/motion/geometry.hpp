@@ -170,6 +170,16 @@ bool corner_bezier_within(const AxisArray& p0, const AxisArray& t1, const AxisAr
                           const AxisArray& t2, double l_mm, const CornerPath& path,
                           double limit_mm, BezierPoints& out) noexcept;
 
+// corner_bezier_within() with the same result, for a Bezier that may lie along one of the
+// moves as a whole, such as the offset corner's lane changes from and back onto a line
+// (Planner::offset_corner): when path.still_at_rest and its four control points lie well
+// within the limit of one chord (within 1 - 1e-5 of it, coordinates within 1e7 times it), the
+// proof by halves is skipped, as it would succeed: the rounding argument is at
+// Proof::surely_near_chord in geometry.cpp. Otherwise it is corner_bezier_within().
+bool shift_bezier_within(const AxisArray& p0, const AxisArray& t1, const AxisArray& p3,
+                         const AxisArray& t2, double l_mm, const CornerPath& path, double limit_mm,
+                         BezierPoints& out) noexcept;
+
 // bezier_within(b, path, limit_mm) for a Bezier whose four points equal path.fixed in the axes
 // neither move changes (as numbers: +0 and -0 alike), such as one built from the moves' points
 // and tangents: when path.still_at_rest those axes add exact zeros to every distance, so the
