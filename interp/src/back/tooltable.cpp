@@ -131,8 +131,8 @@ ParsedLine parse_line(const std::string& line, std::string_view name, int line_n
     return p;
 }
 
-// Calls `each(line, ending, parsed)` for every line of `text` (text_lines::for_each). Checks
-// the whole table first, so that nothing is written from a table the reader would refuse.
+// Calls `each(line, ending, parsed)` for every line of `text` (text_lines::for_each). A bad
+// line throws, so a writer never produces a table from one the reader would refuse.
 template <typename Each>
 void for_each_line(const std::string& text, std::string_view name, Each each) {
     std::set<int> tools;
