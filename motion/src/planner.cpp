@@ -900,7 +900,7 @@ void Planner::emit(const Item& it, MakeProfile&& make_profile) {
         out_head_ = 0;
     }
     PreparedSegment& rec = out_.emplace_back();
-    rec.geom = it.geom;
+    assign_element(rec.geom, it.geom);
     make_profile(rec.profile);  // written in place: a 320-byte copy less per record
     const Profile1D& prof = rec.profile;
     LimitShares rate_share{1 - reserve_, 1 - reserve_};

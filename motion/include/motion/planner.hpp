@@ -92,7 +92,7 @@ class Planner {
     struct Item {
         // Built in place in items_ from its element: value-initialising it first would clear
         // all of it only for add_item() to overwrite it; bounds() writes straight into it.
-        explicit Item(const Element& e) : geom(e), bounds(motion::bounds(e)) {}
+        explicit Item(const Element& e) : geom(element_copy(e)), bounds(motion::bounds(e)) {}
         Element geom;
         ElementBounds bounds;  // bounds(geom), kept for the rate caps when it is emitted
         ElementLimits lim;
