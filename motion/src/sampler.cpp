@@ -22,6 +22,10 @@ constexpr double kPlannedRate = 1 + 1e-12;
 // finish at the highest rate on short segments (0.05 mm at 120 mm/s: 2.4), so the cache is warm
 // by the time the override rises, and the cost stays spread over the periods.
 constexpr std::size_t kWarmRecordsPerPeriod = 8;
+// The jerk-limited checks take the plan over the part of each phase a stretch covers, widened
+// by this much planned time either side: the planned clock the sampler follows is summed in a
+// different order than the checks sum it (rounding errors of 1e-16 s).
+constexpr double kWalkPadS = 1e-9;
 
 bool is_action(const PreparedSegment& rec) noexcept {
     return rec.action.kind != ActionKind::None;
@@ -57,7 +61,116 @@ AxisUse axis_use(const ElementBounds& b, int k, const PhasePeaks& pk, double j_a
                       keep * lim.jerk_mm_s3[k]);
     return u;
 }
+// ---- jerk-limited checks: the plan and the rate as ranges ----------------------------------
+// The jerk-limited checks bound what an axis sees over a stretch of planned time from ranges:
+// the plan's v and a (and its constant j) over the part of a phase the stretch covers, and
+// r, r' over a piece of a rate path (r'' constant). Interval products keep the signs: a rate
+// falling (r' < 0) while the plan speeds up (a > 0) pulls the tangential acceleration
+// a r^2 + v r' back through 0 instead of adding to it.
+struct Span {
+    double lo = 0, hi = 0;
+    double abs_max() const noexcept { return std::max(std::fabs(lo), std::fabs(hi)); }
+};
+Span operator+(Span x, Span y) noexcept {
+    return {x.lo + y.lo, x.hi + y.hi};
+}
+Span operator*(Span x, Span y) noexcept {
+    const double p0 = x.lo * y.lo, p1 = x.lo * y.hi, p2 = x.hi * y.lo, p3 = x.hi * y.hi;
+    return {std::min({p0, p1, p2, p3}), std::max({p0, p1, p2, p3})};
+}
+Span scaled(double c, Span x) noexcept {
+    return c >= 0 ? Span{c * x.lo, c * x.hi} : Span{c * x.hi, c * x.lo};
+}
+
+// The plan over [t_lo, t_hi] of one phase (the phase's own time): v and a as ranges, j constant.
+struct PlanSpan {
+    Span v, a;
+    double j = 0;
+};
+PlanSpan plan_span(const ProfilePhase& ph, double t_lo, double t_hi) noexcept {
+    const double v0 = ph.v0_mm_s, a0 = ph.a0_mm_s2, j = ph.j_mm_s3;
+    auto v_at = [&](double t) { return v0 + a0 * t + j * t * t / 2; };
+    PlanSpan out;
+    const double va = v_at(t_lo), vb = v_at(t_hi);
+    out.v = {std::min(va, vb), std::max(va, vb)};
+    if (j != 0) {
+        const double t_turn = -a0 / j;
+        if (t_turn > t_lo && t_turn < t_hi) {
+            const double vt = v_at(t_turn);
+            out.v = {std::min(out.v.lo, vt), std::max(out.v.hi, vt)};
+        }
+    }
+    const double aa = a0 + j * t_lo, ab = a0 + j * t_hi;
+    out.a = {std::min(aa, ab), std::max(aa, ab)};
+    out.j = j;
+    return out;
+}
+
+// Largest x >= 0 with sqrt((x t + c)^2 + n^2) + x l <= m (c, n, t, l >= 0): on an arc the
+// tangential part (amplitude x t), a part along it (c) and one across it (n) of the in-plane
+// acceleration or jerk add as a rotating vector; l is a helix's linear part. The positive root
+// of (t^2 - l^2) x^2 + 2 (t c + m l) x - (m^2 - c^2 - n^2) = 0, written so that it stays exact
+// for t = l and for l = 0; 0 when c and n use up m.
+double rotating_room(double t, double l, double c, double n, double m) noexcept {
+    const double k = m * m - c * c - n * n;
+    if (!(k > 0) || c >= m) return 0;
+    const double b = t * c + m * l;
+    const double disc = b * b + (t * t - l * l) * k;
+    if (!(disc >= 0)) return 0;
+    const double den = b + std::sqrt(disc);
+    return den > 0 ? k / den : kInf;
+}
+
+// Along the path, with the plan scaled in time: tangential acceleration a_t = a r^2 + v r',
+// tangential jerk j_t = j r^3 + 3 a r r' + v r'', speed u = v r.
+struct PathLoad {
+    Span at, jt, u;
+};
+PathLoad path_load(const PlanSpan& pl, const RateSpan& rb) noexcept {
+    const Span r{std::max(rb.r_lo, 0.0), std::max(rb.r_hi, 0.0)};
+    const Span rd{rb.rd_lo, rb.rd_hi};
+    const Span r2 = r * r;
+    const Span r3{r2.lo * r.lo, r2.hi * r.hi};
+    PathLoad out;
+    out.at = pl.a * r2 + pl.v * rd;
+    out.jt = scaled(pl.j, r3) + scaled(3, pl.a * r * rd) + scaled(rb.rdd, pl.v);
+    out.u = pl.v * r;
+    return out;
+}
+
+// Bounds on axis k's |acceleration| a_t p' + u^2 p'' and |jerk| j_t p' + 3 u a_t p'' + u^3 p'''.
+// On an arc the in-plane p' and p'' are perpendicular and p''' is antiparallel to p' (rotating
+// vectors of amplitudes tangential_in_plane, g2, g3; a helix's linear part only moves with p'),
+// so the parts across add in quadrature; elsewhere every term adds.
+struct AxisLoad {
+    double acc = 0, jerk = 0;
+};
+AxisLoad axis_load(const ElementBounds& b, int k, const PathLoad& pl) noexcept {
+    const double at = pl.at.abs_max(), jt = pl.jt.abs_max(), u = pl.u.abs_max();
+    const double tip = b.tangential_in_plane[k];
+    AxisLoad out;
+    if (tip > 0) {
+        const double lin = b.linear[k], g2 = b.g2[k], g3 = b.g3[k];
+        out.acc = std::hypot(at * tip, u * u * g2) + at * lin;
+        // |j_t tip - u^3 g3| is bilinear in (j_t, u^3): largest at a corner of their ranges.
+        const double w_lo = pl.u.lo * pl.u.lo * pl.u.lo, w_hi = pl.u.hi * pl.u.hi * pl.u.hi;
+        const double along = std::max(
+            {std::fabs(pl.jt.lo * tip - w_lo * g3), std::fabs(pl.jt.lo * tip - w_hi * g3),
+             std::fabs(pl.jt.hi * tip - w_lo * g3), std::fabs(pl.jt.hi * tip - w_hi * g3)});
+        out.jerk = std::hypot(along, 3 * u * at * g2) + jt * lin;
+    } else {
+        out.acc = at * b.g1[k] + u * u * b.g2[k];
+        out.jerk = jt * b.g1[k] + 3 * u * at * b.g2[k] + u * u * u * b.g3[k];
+    }
+    return out;
+}
 }  // namespace
+
+AxisPeak ranged_axis_peak(const ElementBounds& b, int k, const ProfilePhase& ph, double t_lo,
+                          double t_hi, const RateSpan& rate) noexcept {
+    const AxisLoad load = axis_load(b, k, path_load(plan_span(ph, t_lo, t_hi), rate));
+    return {load.acc, load.jerk};
+}
 
 PreparedSegment action_record(const AxisArray& pos_mm, const Action& action,
                               std::int32_t line) noexcept {
@@ -394,11 +507,13 @@ double Sampler::apply_rate(const RatePath& path) noexcept {
     return std::max(passed, 0.0);
 }
 
-// Calls visit(rec, bounds, phase, duration) for every phase of the ring's motion records that
-// overlaps planned time [from, to] (the front record's time), in order, until visit returns
-// false (Walk::Stopped). Walk::Unknown: the ring (or the look-ahead) ends before `to`. `at`
-// carries where the walk may start between calls with rising `from` (the records wholly
-// before it are skipped for good). The records' bounds come from the cache (cached()).
+// Calls visit(rec, bounds, phase, t_lo, t_hi, duration) for every phase of the ring's motion
+// records that overlaps planned time [from, to] (the front record's time), with [t_lo, t_hi] the
+// part of the phase (in its own time) that the stretch covers, widened by kWalkPadS for the
+// rounding of the planned clock, in order, until visit returns false (Walk::Stopped).
+// Walk::Unknown: the ring (or the look-ahead) ends before `to`. `at` carries where the walk may
+// start between calls with rising `from` (the records wholly before it are skipped for good). The
+// records' bounds come from the cache (cached()).
 template <class Visit>
 Sampler::Walk Sampler::walk_phases(double from, double to, WalkFrom& at, Visit&& visit) noexcept {
     const std::size_t n = std::min(ring_.size(), cfg_.lookahead_records);
@@ -415,7 +530,10 @@ Sampler::Walk Sampler::walk_phases(double from, double to, WalkFrom& at, Visit&&
                 const double t0 = p.phases[ph].t0_s;
                 const double t1 = ph + 1 < p.count ? p.phases[ph + 1].t0_s : p.duration_s;
                 if (start + t1 < from || start + t0 > to) continue;
-                if (!visit(rec, b, p.phases[ph], t1 - t0)) return Walk::Stopped;
+                const double len = std::max(0.0, t1 - t0);
+                const double lo = std::clamp(from - (start + t0) - kWalkPadS, 0.0, len);
+                const double hi = std::clamp(to - (start + t0) + kWalkPadS, lo, len);
+                if (!visit(rec, b, p.phases[ph], lo, hi, len)) return Walk::Stopped;
             }
         }
         start += p.duration_s;
@@ -427,10 +545,16 @@ Sampler::Walk Sampler::walk_phases(double from, double to, WalkFrom& at, Visit&&
 }
 
 // Bounds for the proposal: the least room, over the stretch the move and its brake may cover,
-// left by each phase at the highest rate reached there: r' from the acceleration left beside
-// a r^2 and from half the jerk left beside j r^3 (the 3 a r r' term), r'' from the other half
-// (the v r'' term). Never below the fixed bounds (valid anywhere at r <= 1); only a proposal:
-// rate_path_safe() decides.
+// left by each phase (over the part of it the stretch covers) at the rates reached there:
+// - r' from the acceleration: the tangential acceleration an axis allows beside the
+//   centripetal part at the highest speed (on an arc the two add in quadrature), with the
+//   move's r' of the sign it heads in: slowing (r' < 0) where the plan speeds up (a > 0) has
+//   that room plus a r^2, not minus it. The symmetric form (A - Acc r^2) / V, which also uses
+//   the planner's (1 - reserve) guarantee, is taken where it gives more;
+// - r' also from half the jerk left beside j r^3 (the 3 a r r' term), r'' from the other half
+//   (the v r'' term).
+// Never below the fixed bounds (valid anywhere at r <= 1); only a proposal: rate_path_safe()
+// decides.
 RateLimits Sampler::jerk_room_limits(double target, double dt) noexcept {
     const double vm0 = last_limits_.max_rate_per_s, am0 = last_limits_.max_rate_per_s2;
     // The highest rate the move and its brake may reach: r' at most vm0 more for that long.
@@ -440,31 +564,79 @@ RateLimits Sampler::jerk_room_limits(double target, double dt) noexcept {
         std::min(cfg_.max_rate,
                  std::max({r_, r_ + up * up / (2 * am0), std::min(target, r_ + vm0 * reach_s)}));
     if (r_hi > 1) reach_s += (r_hi - 1) / vm0 + vm0 / am0;
+    const bool slowing = target < r_ && target < 1;
+    const double down = std::min(rd_, 0.0);
+    const double r_lo = slowing ? 0.0 : std::max(0.0, r_ - down * down / (2 * am0));
+    const Span r_span{r_lo, r_hi};
+    const Span r2_span = r_span * r_span;
     const AxisLimits& lim = cfg_.limits;
     const double js = cfg_.junction_share;
     double vm = kInf, am = kInf;
     auto visit = [&](const PreparedSegment& rec, const ElementBounds& b, const ProfilePhase& ph,
-                     double dur) {
+                     double t_lo, double t_hi, double dur) {
         const double keep = 1 - cfg_.override_reserve - (rec.rough ? js : 0);
         const double free_a = 1 - (rec.rough ? js * r_hi : 0);
         const double free_j = 1 - (rec.rough ? js * r_hi * r_hi : 0);
-        const PhasePeaks pk = phase_peaks(ph, dur);
+        // Speeding up keeps the whole phase's peaks and the symmetric form: under the room of
+        // the part ahead the rate climbs close to 1 while the plan still accelerates, and its
+        // r' then has to be braked in the jerk phase that ends the acceleration, where little
+        // room is left (measured: 40 % -> 100 % in the first acceleration took up to 0.54 s
+        // that way, 0.15 s with the whole phase).
+        const PlanSpan pl = slowing ? plan_span(ph, t_lo, t_hi) : plan_span(ph, 0, dur);
+        const PhasePeaks pk{pl.v.abs_max(), pl.a.abs_max()};
+        const Span plan_at = pl.a * r2_span;  // a r^2 over the rates the move may pass
+        const double u_hi = pk.v_mm_s * r_hi;
         for (int q = 0; q < b.axis_count; ++q) {
             const int k = b.axes[q];
             const AxisUse use = axis_use(b, k, pk, std::fabs(ph.j_mm_s3), keep, lim);
-            if (use.vel > 1e-12)
-                vm = std::min(vm, (free_a * lim.acc_mm_s2[k] - use.acc * r_hi * r_hi) / use.vel);
+            if (use.vel <= 1e-12) continue;  // the axis does not move here
+            const double tip = b.tangential_in_plane[k];
+            const double m = free_a * lim.acc_mm_s2[k], cen = u_hi * u_hi * b.g2[k];
+            const double at_room =
+                tip > 0 ? rotating_room(tip, b.linear[k], 0, cen, m) : (m - cen) / b.g1[k];
+            const bool plan_fits = plan_at.abs_max() <= at_room;
+            const double signed_room =
+                slowing && plan_fits ? (at_room + plan_at.lo) / pk.v_mm_s : 0.0;
+            const double symmetric = (m - use.acc * r_hi * r_hi) / use.vel;
+            const double vm_acc = std::max(signed_room, symmetric);
+            vm = std::min(vm, vm_acc);
             if (lim.jerk_mm_s3[k] <= 0) continue;
-            const double left = free_j * lim.jerk_mm_s3[k] - use.jerk * r_hi * r_hi * r_hi;
-            if (use.acc * r_hi > 1e-12) vm = std::min(vm, left / (2 * 3 * r_hi * use.acc));
-            if (use.vel > 1e-12) am = std::min(am, left / (2 * use.vel));
+            const double mj = free_j * lim.jerk_mm_s3[k];
+            const double left = mj - use.jerk * r_hi * r_hi * r_hi;
+            double vm_j = use.acc * r_hi > 1e-12 ? left / (2 * 3 * r_hi * use.acc) : kInf;
+            double am_j = left / (2 * use.vel);
+            if (slowing && tip > 0) {
+                // On an arc the r' terms of the jerk (3 u a_t p'', a_t = a r^2 + v r') lie
+                // across p' and add in quadrature to the r'' term (v r'' p') and the rest
+                // along it: half of what is left along p' for r'', what that leaves across
+                // for r'.
+                const double a_hi = pk.a_mm_s2, j_r3 = std::fabs(ph.j_mm_s3) * r_hi * r_hi * r_hi;
+                const double along0 = j_r3 * tip + u_hi * u_hi * u_hi * b.g3[k];
+                if (along0 < mj) {
+                    const double share = (mj - along0) / (a_hi > 0 ? 4 : 2);
+                    const double along = mj - share * (a_hi > 0 ? 2 : 1);
+                    const double across = std::sqrt(mj * mj - along * along);
+                    double vm_q = (across / (3 * u_hi * b.g2[k]) - a_hi * r_hi * r_hi) / pk.v_mm_s;
+                    if (a_hi > 0) vm_q = std::min(vm_q, share / (3 * a_hi * r_hi * tip));
+                    const double am_q = share / (pk.v_mm_s * tip);
+                    if (vm_q > 0 && am_q > 0 &&
+                        1 / std::min(vm_q, vm_acc) + std::min(vm_q, vm_acc) / am_q <
+                            1 / std::min(vm_j, vm_acc) + std::min(vm_j, vm_acc) / am_j) {
+                        vm_j = vm_q;
+                        am_j = am_q;
+                    }
+                }
+            }
+            vm = std::min(vm, vm_j);
+            am = std::min(am, am_j);
         }
         return true;
     };
     WalkFrom at;
     if (walk_phases(tau_, tau_ + r_hi * reach_s, at, visit) == Walk::Unknown) {
-        vm = std::min(vm, rl_.max_rate_per_s);  // nothing is known beyond the ring
-        am = std::min(am, rl_.max_rate_per_s2);
+        const RateLimits beyond = unknown_room(r_hi);  // only the planner's guarantees
+        vm = std::min(vm, beyond.max_rate_per_s);
+        am = std::min(am, beyond.max_rate_per_s2);
     }
     // Where nothing moves any rate change fits; the ramps stay finite (kRateRampS) anyway.
     vm = std::clamp(vm, rl_.max_rate_per_s, cfg_.max_rate / kRateRampS);
@@ -473,10 +645,10 @@ RateLimits Sampler::jerk_room_limits(double target, double dt) noexcept {
 }
 
 // Whether following `path` from (tau_, r_, r_'), then holding the rate it ends at, keeps every
-// axis within its limits. Each piece covers planned time [tau, tau + dtau] with r and |r'| at
-// most their largest values over it (r is quadratic and r' linear in time on a piece). A piece
-// at a steady r <= 1 is a pure time scale of the plan: always fine. The path must end with
-// r' = 0 and r <= 1.
+// axis within its limits. Each piece covers planned time [tau, tau + dtau] with r between its
+// least and largest value over it (r is quadratic and r' linear in time on a piece) and r'
+// between its ends. A piece at a steady r <= 1 is a pure time scale of the plan: always fine.
+// The path must end with r' = 0 and r <= 1.
 bool Sampler::rate_path_safe(const RatePath& path) noexcept {
     RateState s{r_, rd_};
     double tau = tau_;
@@ -492,41 +664,61 @@ bool Sampler::rate_path_safe(const RatePath& path) noexcept {
             r_lo = std::min(r_lo, r_turn);
         }
         if (r_lo < -1e-9) return false;
-        const double rd_max = std::max(std::fabs(s.rd), std::fabs(rd1));
+        const RateSpan box{r_lo, r_hi, std::min(s.rd, rd1), std::max(s.rd, rd1), pc.u};
         RateState e = s;
         const double dtau = step_rate(e, pc);
-        const bool pure_scale = rd_max == 0 && pc.u == 0 && r_hi <= kPlannedRate;
-        if (!pure_scale && !stretch_safe(tau, tau + dtau, r_hi, rd_max, std::fabs(pc.u), at))
-            return false;
+        const bool pure_scale =
+            box.rd_lo == 0 && box.rd_hi == 0 && pc.u == 0 && r_hi <= kPlannedRate;
+        if (!pure_scale && !stretch_safe(tau, tau + dtau, box, at)) return false;
         s = e;
         tau += dtau;
     }
     return s.rd == 0 && s.r <= kPlannedRate;
 }
 
-// Axis k sees at most: velocity V r, acceleration Acc r^2 + V |r'|, jerk
-// Jrk r^3 + 3 Acc r |r'| + V |r''| (axis_use()). Next to a rough junction the step there
-// (junction share, times r for a velocity step, r^2 for a curvature step) is kept out too.
-bool Sampler::stretch_safe(double from, double to, double r_hi, double rd_max, double rdd_max,
-                           WalkFrom& at) noexcept {
+// Axis k sees at most the smaller of two bounds, both over the part of each phase the stretch
+// covers:
+// - acceleration Acc r^2 + V |r'|, jerk Jrk r^3 + 3 Acc r |r'| + V |r''| (axis_use(): the
+//   plan's peaks, Acc and Jrk at most what the planner keeps to);
+// - axis_load(): the tangential acceleration and jerk as signed ranges, with an arc's
+//   rotating parts in quadrature.
+// Next to a rough junction the step there (junction share, times r for a velocity step, r^2
+// for a curvature step) is kept out too.
+bool Sampler::stretch_safe(double from, double to, const RateSpan& box, WalkFrom& at) noexcept {
     const AxisLimits& lim = cfg_.limits;
     const double js = cfg_.junction_share;
+    const double r_hi = box.r_hi, rdd_max = std::fabs(box.rdd);
+    const double rd_max = std::max(std::fabs(box.rd_lo), std::fabs(box.rd_hi));
     const double r2 = r_hi * r_hi, r3 = r2 * r_hi;
     auto visit = [&](const PreparedSegment& rec, const ElementBounds& b, const ProfilePhase& ph,
-                     double dur) {
+                     double t_lo, double t_hi, double dur) {
         const double keep = 1 - cfg_.override_reserve - (rec.rough ? js : 0);
         const double free_a = 1 - (rec.rough ? js * r_hi : 0);
         const double free_j = 1 - (rec.rough ? js * r2 : 0);
-        const PhasePeaks pk = phase_peaks(ph, dur);
+        const PlanSpan pl = plan_span(ph, t_lo, t_hi);
+        const PhasePeaks pk{pl.v.abs_max(), pl.a.abs_max()};
+        // The ranged bound costs more: it is worked out only where the first one fails.
+        PathLoad load;
+        bool have_load = false;
         for (int q = 0; q < b.axis_count; ++q) {
             const int k = b.axes[q];
             const AxisUse use = axis_use(b, k, pk, std::fabs(ph.j_mm_s3), keep, lim);
             if (r_hi > kPlannedRate && use.vel * r_hi > lim.vel_mm_s[k]) return false;
-            if (use.acc * r2 + use.vel * rd_max > free_a * lim.acc_mm_s2[k]) return false;
-            if (lim.jerk_mm_s3[k] > 0 && use.jerk * r3 + 3 * r_hi * use.acc * rd_max +
-                                                 use.vel * rdd_max >
-                                             free_j * lim.jerk_mm_s3[k])
-                return false;
+            const double acc_max = free_a * lim.acc_mm_s2[k];
+            const bool jerk_limited = lim.jerk_mm_s3[k] > 0;
+            const double jerk_max = free_j * lim.jerk_mm_s3[k];
+            const bool acc_ok = use.acc * r2 + use.vel * rd_max <= acc_max;
+            const bool jerk_ok =
+                !jerk_limited ||
+                use.jerk * r3 + 3 * r_hi * use.acc * rd_max + use.vel * rdd_max <= jerk_max;
+            if (acc_ok && jerk_ok) continue;
+            if (!have_load) {
+                load = path_load(pl, box);
+                have_load = true;
+            }
+            const AxisLoad ranged = axis_load(b, k, load);
+            if (!acc_ok && ranged.acc > acc_max) return false;
+            if (!jerk_ok && ranged.jerk > jerk_max) return false;
         }
         return true;
     };
@@ -538,7 +730,54 @@ bool Sampler::stretch_safe(double from, double to, double r_hi, double rd_max, d
         case Walk::Unknown:  // beyond the ring nothing is known: only the fixed bounds hold
             break;
     }
-    return r_hi <= kPlannedRate && rd_max <= rl_.max_rate_per_s && rdd_max <= rl_.max_rate_per_s2;
+    return unknown_safe(box);
+}
+
+// Beyond the records in the ring (or the look-ahead) nothing is known of the plan but what the
+// planner guarantees of every record at r = 1, per axis: speed V <= vmax, |acceleration| Acc <=
+// (1 - reserve) A, |jerk| Jrk <= (1 - reserve) J, and next to a rough junction Acc, Jrk <=
+// (1 - reserve - junction share) of them with the step there kept out (stretch_safe()). At a
+// rate r <= 1 that leaves, whichever the record is,
+//     V |r'| <= A (1 - (1 - reserve) r^2 - share r (1 - r)),
+//     3 r (1 - reserve) A |r'| + V |r''| <= J (1 - (1 - reserve) r^3 - share r^2 (1 - r))
+// (the rough case's larger left side and the other's, the smaller right side). At r = 1 this is
+// the fixed reserve bounds (rate_limits()); as the rate falls it grows, so a stop that runs
+// past what the ring holds need not crawl at 1 % of the acceleration.
+bool Sampler::unknown_safe(const RateSpan& box) const noexcept {
+    if (box.r_hi > kPlannedRate) return false;
+    const double rd = std::max(std::fabs(box.rd_lo), std::fabs(box.rd_hi));
+    const double rdd = std::fabs(box.rdd);
+    if (rd <= rl_.max_rate_per_s && rdd <= rl_.max_rate_per_s2) return true;  // the fixed bounds
+    const double r = std::clamp(box.r_hi, 0.0, 1.0), keep = 1 - cfg_.override_reserve;
+    const double js = cfg_.junction_share;
+    const double acc_left = 1 - keep * r * r - js * r * (1 - r);
+    const double jerk_left = 1 - keep * r * r * r - js * r * r * (1 - r);
+    const AxisLimits& lim = cfg_.limits;
+    for (int k = 0; k < kAxes; ++k) {
+        const double v = lim.vel_mm_s[k], a = lim.acc_mm_s2[k], j = lim.jerk_mm_s3[k];
+        if (v * rd > a * acc_left) return false;
+        if (j > 0 && 3 * r * keep * a * rd + v * rdd > j * jerk_left) return false;
+    }
+    return true;
+}
+
+// The proposal's bounds where the stretch runs past the ring: unknown_safe()'s room at rates
+// up to r_hi, half the jerk left to each of the r' and r'' terms; never below the fixed bounds.
+RateLimits Sampler::unknown_room(double r_hi) const noexcept {
+    const double r = std::clamp(r_hi, 0.0, 1.0), keep = 1 - cfg_.override_reserve;
+    const double js = cfg_.junction_share;
+    const double acc_left = 1 - keep * r * r - js * r * (1 - r);
+    const double jerk_left = 1 - keep * r * r * r - js * r * r * (1 - r);
+    const AxisLimits& lim = cfg_.limits;
+    double vm = kInf, am = kInf;
+    for (int k = 0; k < kAxes; ++k) {
+        const double v = lim.vel_mm_s[k], a = lim.acc_mm_s2[k], j = lim.jerk_mm_s3[k];
+        if (v > 0) vm = std::min(vm, a * acc_left / v);
+        if (j <= 0) continue;
+        if (r * a > 0) vm = std::min(vm, j * jerk_left / (2 * 3 * r * keep * a));
+        if (v > 0) am = std::min(am, j * jerk_left / (2 * v));
+    }
+    return {std::max(vm, rl_.max_rate_per_s), std::max(am, rl_.max_rate_per_s2)};
 }
 
 // Without a jerk limit, slowing down from a rate <= 1 (hold, abort, override down): as r falls,

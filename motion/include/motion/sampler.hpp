@@ -16,14 +16,17 @@
 //   under bounds taken from the room of the stretch ahead (jerk_room_limits()), and accepts it
 //   only if that move, followed by its backup (r' braked to 0, then r brought down to at most
 //   1, then held; brake_path()), keeps every axis within its velocity, acceleration and jerk
-//   limits over every profile phase it covers (rate_path_safe(): the plan's per-phase peaks
-//   against a r^2 + v r' and j r^3 + 3 a r r' + v r''). Otherwise the period follows the backup
-//   accepted before (cert_), which stays valid because it was checked to its end. A rate held at
-//   r <= 1 is a pure time scale, which the plan keeps within (1 - reserve) of every limit, so
-//   the backup always ends safe; beyond the records in the ring only the fixed bounds
-//   (rate_limits()) are trusted. The rate then changes quickly where the plan leaves room
-//   (cruise, r < 1) and waits, where the plan uses nearly all of an axis's acceleration or
-//   jerk, until it leaves room.
+//   limits over the part of every profile phase it covers (rate_path_safe(): per piece, the
+//   smaller of two bounds on a r^2 + v r' and j r^3 + 3 a r r' + v r'': the plan's peaks
+//   with the terms added, and the terms as signed ranges with an arc's perpendicular parts in
+//   quadrature, ranged_axis_peak()). Otherwise the period follows the backup accepted before
+//   (cert_), which stays valid because it was checked to its end. A rate held at r <= 1 is a
+//   pure time scale, which the plan keeps within (1 - reserve) of every limit, so the backup
+//   always ends safe; beyond the records in the ring only what the planner guarantees of every
+//   record is trusted (unknown_safe(): the fixed bounds at r = 1, more as r falls). The rate
+//   then changes quickly where the plan leaves room (cruise, r < 1, slowing while the plan
+//   speeds up) and waits, where the plan uses nearly all of an axis's jerk at r near 1, until
+//   it leaves room.
 // Above r = 1 the per-phase rate caps of the records within reach shape the target, and the
 // checks above keep a r^2, j r^3 and v r within the limits. So any override in [0, max_rate],
 // any hold and any abort keeps every axis within its limits.
@@ -96,6 +99,23 @@ struct RatePath {
     }
 };
 
+// A rate path's piece as the checks see it: r and r' between lo and hi, r'' constant.
+struct RateSpan {
+    double r_lo = 0, r_hi = 0;
+    double rd_lo = 0, rd_hi = 0;
+    double rdd = 0;
+};
+
+// What axis k of an element with derivative bounds b sees at most while the plan runs profile
+// phase `ph` over [t_lo, t_hi] of the phase's own time with the rate inside `rate`: the ranged
+// bound of the jerk-limited checks (sampler.cpp), one of the two they take the smaller of.
+// Realtime-safe; public for its tests.
+struct AxisPeak {
+    double acc_mm_s2 = 0, jerk_mm_s3 = 0;
+};
+AxisPeak ranged_axis_peak(const ElementBounds& b, int k, const ProfilePhase& ph, double t_lo,
+                          double t_hi, const RateSpan& rate) noexcept;
+
 struct SamplerStatus {
     bool moving = false;   // rate > 0 and a record is being followed
     bool done = false;     // at the end of a program_end record, nothing queued
@@ -166,9 +186,12 @@ class Sampler {
         double start_s = 0;     // its start in the front record's planned time
     };
     // The phases of the ring's records over planned time [from, to] (front record's time) are
-    // fine with rates up to r_hi, |r'| up to rd_max and |r''| up to rdd_max.
-    bool stretch_safe(double from, double to, double r_hi, double rd_max, double rdd_max,
-                      WalkFrom& at) noexcept;
+    // fine with the rate, its r' and r'' within `box` (sampler.cpp).
+    bool stretch_safe(double from, double to, const RateSpan& box, WalkFrom& at) noexcept;
+    // Beyond the ring: whether a piece keeps the limits whatever the plan there, and the
+    // proposal's bounds for that.
+    bool unknown_safe(const RateSpan& box) const noexcept;
+    RateLimits unknown_room(double r_hi) const noexcept;
     double apply_rate(const RatePath& path) noexcept;
     enum class Walk : unsigned char { Covered, Stopped, Unknown };
     template <class Visit>
