@@ -576,11 +576,10 @@ TEST(SamplerJerk, HoldOnAnArcAtItsTurningLimitTakesAboutAsLongAsOnALine) {
 }
 
 // Holds at every 10 ms of circles and helices at their turning limits (acceleration-bound at
-// R = 5 mm, jerk-bound at R = 1 mm with 10 000 mm/s^3) keep every axis within its limits: the
-// quadrature bounds above are only right while p' and p'' are perpendicular in the plane and
-// p''' antiparallel to p', with a helix's rise moving along p' alone. Counting the rise
-// inside the quadrature, or the 3 u a_t p'' term along p', shows here as an axis over its
-// acceleration or jerk limit.
+// R = 5 mm, jerk-bound at R = 1 mm with 10 000 mm/s^3) keep every axis within its limits in
+// every period, where the quadrature bounds above decide. (A wrong bound in the check alone
+// is not caught here, as the proposals stay within the right one:
+// RangedAxisPeakIsNeverBelowTheSampledMotion tests the bound itself.)
 TEST(SamplerJerk, HoldsOnCirclesAndHelicesAtTheirTurningLimitsKeepTheLimits) {
     struct Case {
         double radius_mm, jerk, rise_mm;
@@ -620,10 +619,12 @@ TEST(SamplerJerk, HoldInsideTheAccelerationPhaseDoesNotWaitForItsEnd) {
 // lines, arcs and helices in the three planes, random phases of the plan (any sign of v, a, j),
 // random parts of them and random rate boxes. At every sample (17 points along the element, 9
 // times in the part, r at both ends and the middle of its range, r' at both ends) each axis's
-// |a_t p' + u^2 p''| and |j_t p' + 3 u a_t p'' + u^3 p'''| stays within the bound. An arc's
-// quadrature counted wrongly (the 3 u a_t p'' term taken as along p', or the helix's rise
-// inside the rotating part) shows here as a sample above its bound. On a circle in cruise at a
-// fixed rate the bound is also reached (within 0.1 %): it is the exact largest value.
+// |a_t p' + u^2 p''| and |j_t p' + 3 u a_t p'' + u^3 p'''| stays within the bound. Dropping
+// the 3 u a_t p'' term, the u^3 p''' term, v r' from a_t or 3 a r r' from j_t shows here as a
+// sample above its bound (checked by editing each). On a circle in cruise at a fixed rate the
+// bound is also reached (within 0.1 %): it is the exact largest value, so adding the across
+// term along p' fails too. (In the three planes a helix's rise is on the normal axis, which has
+// no rotating part, so its terms are not told apart here.)
 TEST(SamplerJerk, RangedAxisPeakIsNeverBelowTheSampledMotion) {
     std::mt19937_64 rng(7);
     std::uniform_real_distribution<double> u01(0, 1);
