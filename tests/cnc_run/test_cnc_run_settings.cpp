@@ -311,3 +311,34 @@ TEST(CncRunSettings, WithoutSettingsDirTheFilesAreBesideTheIni) {
 }
 
 }  // namespace
+
+// `cnc canon --settings FILE --save-settings` writes the same files a machine does, so it takes
+// the same lock: refused (setup error, exit 2, nothing run or written) while another process
+// holds FILE, and saves once it is free.
+TEST(CncCanonSettings, SavingSettingsTakesTheRunLock) {
+    const ScratchDir scratch;
+    const fs::path settings = scratch.path() / "settings.txt";
+    const fs::path prog = scratch.path() / "g92.ngc";
+    std::ofstream(settings) << "wcs 2 100 0 0 0 0 0\n";
+    std::ofstream(prog) << "G90 G21\nG0 X10 Y20\nG92 X0 Y0\nM30\n";
+    const std::string cmd =
+        fmt::format("'{}' canon '{}' --settings '{}' --save-settings > '{}' 2> '{}'", CNC_BIN,
+                    prog.string(), settings.string(), (scratch.path() / "out.txt").string(),
+                    (scratch.path() / "err.txt").string());
+    {
+        const interp::SettingsFileLock held(settings.string());
+        const int status = std::system(cmd.c_str());
+        ASSERT_TRUE(WIFEXITED(status));
+        EXPECT_EQ(WEXITSTATUS(status), 2);
+        EXPECT_NE(slurp(scratch.path() / "err.txt")
+                      .find(fmt::format("{}: settings file in use by another run (pid {})",
+                                        settings.string(), ::getpid())),
+                  std::string::npos)
+            << slurp(scratch.path() / "err.txt");
+        EXPECT_EQ(slurp(settings), "wcs 2 100 0 0 0 0 0\n");
+    }
+    const int status = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 0) << slurp(scratch.path() / "err.txt");
+    EXPECT_NE(slurp(settings).find("g92 10 20 0 0 0 0\n"), std::string::npos) << slurp(settings);
+}

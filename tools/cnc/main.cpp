@@ -104,6 +104,10 @@ void attach_saver(interp::Executor& exec, const CommonOptions& o) {
 }
 
 int run_canon(const CommonOptions& o, const std::string& format, const std::string& out_path) {
+    // Taken before the settings are read, so a `cnc run` on the same file cannot change them
+    // between our read and our saves (the last save would win).
+    std::optional<interp::SettingsFileLock> settings_lock;
+    if (!o.settings.empty() && o.save_settings) settings_lock.emplace(o.settings);
     Session s = make_session(o);
     std::FILE* out = stdout;
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(nullptr, &std::fclose);
