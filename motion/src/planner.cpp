@@ -185,7 +185,7 @@ void Planner::push(const PathSegment& seg) {
 void Planner::finish() {
     if (have_pending_) close_piece(pieces_[pending_], nullptr);
     have_pending_ = false;
-    if (plan_and_emit(true) > 0) out_.back().program_end = true;
+    if (plan_and_emit(true) > 0) out_.back().rec().program_end = true;
     v_start_ = 0;
 }
 
@@ -893,14 +893,28 @@ void Planner::emit_group(const Group& g, double v_in, double v_out) {
     }
 }
 
+// emit() writes every member of the record it makes (its slot is not cleared first): a new
+// member makes this fail until emit() writes it too.
+static_assert(sizeof(PreparedSegment) ==
+                  sizeof(Element) + sizeof(Profile1D) + kMaxPhases * 8 + 4 + 4 + 3 + 5 +
+                      sizeof(Action) + 8 + 8 + 4 + 4 + kProbeAxes * sizeof(ProbeAxis),
+              "emit() writes every member of PreparedSegment: add new ones there");
+static_assert(sizeof(Profile1D) == kMaxPhases * sizeof(ProfilePhase) + 8 + 4 * 8,
+              "emit() writes every member of Profile1D: add new ones there");
+
 template <class MakeProfile>
 void Planner::emit(const Item& it, MakeProfile&& make_profile) {
     if (out_head_ == out_.size()) {
         out_.clear();
         out_head_ = 0;
     }
-    PreparedSegment& rec = out_.emplace_back();
+    // Every member is written here (the slot's bytes are not cleared, see RecordSlot), the
+    // profile's first as make_profile expects of a default one.
+    PreparedSegment& rec = out_.emplace_back().rec();
     assign_element(rec.geom, it.geom);
+    rec.profile.count = 0;
+    rec.profile.duration_s = rec.profile.peak_v_mm_s = 0;
+    rec.profile.peak_a_mm_s2 = rec.profile.peak_j_mm_s3 = 0;
     make_profile(rec.profile);  // written in place: a 320-byte copy less per record
     const Profile1D& prof = rec.profile;
     LimitShares rate_share{1 - reserve_, 1 - reserve_};
@@ -919,11 +933,21 @@ void Planner::emit(const Item& it, MakeProfile&& make_profile) {
                                          : rate_cap(b, cfg_.limits, v, a, std::fabs(ph.j_mm_s3),
                                                     rate_share, cfg_.max_rate);
     }
+    // The phases the profile does not use stay as a default record's.
+    for (int i = prof.count; i < kMaxPhases; ++i) {
+        rec.profile.phases[i] = ProfilePhase{};
+        rec.phase_rate_cap[i] = 0;
+    }
     rec.line = it.line;
-    rec.move_id = it.move_id;
-    rec.rapid = it.rapid;
-    rec.rough = it.rough;
     rec.seq = seq_++;
+    rec.rapid = it.rapid;
+    rec.program_end = false;
+    rec.rough = it.rough;
+    rec.action = Action{};
+    rec.dout_set = rec.dout_clear = 0;
+    rec.message = 0;
+    rec.move_id = it.move_id;
+    rec.probe = {};
 }
 
 bool Planner::pop(PreparedSegment& out) noexcept {
@@ -935,7 +959,7 @@ bool Planner::pop(PreparedSegment& out) noexcept {
 
 std::size_t Planner::take(std::span<PreparedSegment> out) noexcept {
     std::size_t n = std::min(out.size(), ready());
-    std::copy_n(out_.begin() + static_cast<std::ptrdiff_t>(out_head_), n, out.begin());
+    for (std::size_t i = 0; i < n; ++i) out[i] = out_[out_head_ + i].rec();
     out_head_ += n;
     return n;
 }
