@@ -392,6 +392,33 @@ bool Planner::bezier_corner(const Piece& p, const Piece& next, double sin_angle,
     return true;
 }
 
+namespace {
+
+// What an offset corner between the unit tangents t1 and t2 (turning by the angle whose cosine
+// and sine are given) asks of the axes: the outward normals n1, n2 off the incoming and the
+// outgoing move (in their common plane); `turn`, the smallest A_k / |t2_k - t1_k|, which sets
+// the turn's speed; `shift`, the largest |n_k| / A_k, which sets the lane changes' length.
+struct OffsetFrame {
+    AxisArray n1, n2;
+    double turn = kInf, shift = 0;
+};
+
+OffsetFrame offset_frame(const AxisArray& t1, const AxisArray& t2, double cos_t, double sin_t,
+                         const AxisLimits& lim) {
+    OffsetFrame f;
+    for (int k = 0; k < kAxes; ++k) {
+        f.n1[k] = -(t2[k] - cos_t * t1[k]) / sin_t;
+        f.n2[k] = (t1[k] - cos_t * t2[k]) / sin_t;
+        double dt = std::fabs(t2[k] - t1[k]);
+        if (dt > 0) f.turn = std::min(f.turn, lim.acc_mm_s2[k] / dt);
+        f.shift = std::max(f.shift,
+                           std::max(std::fabs(f.n1[k]), std::fabs(f.n2[k])) / lim.acc_mm_s2[k]);
+    }
+    return f;
+}
+
+}  // namespace
+
 // The offset corner (no jerk limit; two lines turning by up to about 90 degrees). The parabola
 // alone cuts at most P inside the corner, but the tolerance also allows P outside it. So the
 // tool shifts d <= P outwards off the incoming line (a cubic lane change, shift_out), turns on
@@ -428,16 +455,9 @@ bool Planner::offset_corner(const Piece& p, const Piece& next, double sin_angle,
     // lets a shift pass at kShiftSpeedFactor times it on kShiftCentripetal of the acceleration
     // (a shift's sideways second derivative peaks at 6 d / ls^2). A much shorter shift caps
     // the speed on the way into the corner and costs more than the corner gains.
-    const AxisLimits& lim = cfg_.limits;
-    AxisArray n1, n2;
-    double turn = kInf, shift = 0;
-    for (int k = 0; k < kAxes; ++k) {
-        n1[k] = -(t2[k] - cos_t * t1[k]) / sin_t;
-        n2[k] = (t1[k] - cos_t * t2[k]) / sin_t;
-        double dt = std::fabs(t2[k] - t1[k]);
-        if (dt > 0) turn = std::min(turn, lim.acc_mm_s2[k] / dt);
-        shift = std::max(shift, std::max(std::fabs(n1[k]), std::fabs(n2[k])) / lim.acc_mm_s2[k]);
-    }
+    const OffsetFrame f = offset_frame(t1, t2, cos_t, sin_t, cfg_.limits);
+    const AxisArray &n1 = f.n1, &n2 = f.n2;
+    const double turn = f.turn, shift = f.shift;
     const double v_corner_mm_s = std::sqrt(2 * lp * turn);
     const double ls =
         kShiftSpeedFactor * v_corner_mm_s * std::sqrt(6 * d * shift / kShiftCentripetal);
@@ -577,16 +597,9 @@ bool Planner::offset_arc_corner(const Piece& p, const Piece& next, double sin_an
     // A carried arc keeps at least half its radius (d <= tol).
     for (const Element* e : {&p.geom, &next.geom})
         if (e->kind == ElementKind::Arc && !(e->radius_mm > 2 * tol)) return false;
-    const AxisLimits& lim = cfg_.limits;
-    AxisArray n1, n2;
-    double turn = kInf, shift = 0;
-    for (int k = 0; k < kAxes; ++k) {
-        n1[k] = -(t2[k] - cos_t * t1[k]) / sin_t;
-        n2[k] = (t1[k] - cos_t * t2[k]) / sin_t;
-        double dt = std::fabs(t2[k] - t1[k]);
-        if (dt > 0) turn = std::min(turn, lim.acc_mm_s2[k] / dt);
-        shift = std::max(shift, std::max(std::fabs(n1[k]), std::fabs(n2[k])) / lim.acc_mm_s2[k]);
-    }
+    const OffsetFrame f = offset_frame(t1, t2, cos_t, sin_t, cfg_.limits);
+    const AxisArray &n1 = f.n1, &n2 = f.n2;
+    const double turn = f.turn, shift = f.shift;
     // Room for the shifts: a line before the corner may give all it has left after the corner
     // at its start, an arc kMaxArcTrimShare of itself; the move after, what max_trim_mm allows.
     const double L1 = p.geom.length_mm;
