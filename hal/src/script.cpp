@@ -222,6 +222,7 @@ void Script::cmd_loadusr(const std::vector<std::string>& words) {
     if (i >= words.size()) throw Error("usage: loadusr [-W|-w|-i|-Wn NAME] PROGRAM [ARGS...]");
     std::vector<std::string> argv(words.begin() + static_cast<long>(i), words.end());
     if (name.empty()) name = argv[0].substr(argv[0].rfind('/') + 1);
+    const std::string program = argv[0];  // as the file wrote it, for messages
     // Our own tools (halsampler, halstreamer, …) come before same-named programs on PATH,
     // e.g. LinuxCNC's, which would attach to the wrong bus.
     if (argv[0].find('/') == std::string::npos) {
@@ -257,7 +258,7 @@ void Script::cmd_loadusr(const std::vector<std::string>& words) {
     if (wait_exit) {
         int status = wait_child();
         if (!ignore_status && (!WIFEXITED(status) || WEXITSTATUS(status) != 0))
-            throw Error(fmt::format("loadusr: '{}' failed ({})", argv[0],
+            throw Error(fmt::format("loadusr: '{}' failed ({})", program,
                                     WIFEXITED(status) ? fmt::format("exit status {}", WEXITSTATUS(status))
                                                       : fmt::format("signal {}", WTERMSIG(status))));
         return;
@@ -269,7 +270,7 @@ void Script::cmd_loadusr(const std::vector<std::string>& words) {
             int status = 0;
             if (::waitpid(pid, &status, WNOHANG) == pid) {
                 children_.erase(name);
-                throw Error(fmt::format("loadusr: '{}' exited before component '{}' became ready", argv[0], name));
+                throw Error(fmt::format("loadusr: '{}' exited before component '{}' became ready", program, name));
             }
             if (steady_clock::now() > deadline) {
                 throw Error(fmt::format("loadusr: component '{}' not ready after 30 s", name));
