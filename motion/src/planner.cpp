@@ -411,10 +411,45 @@ OffsetFrame offset_frame(const AxisArray& t1, const AxisArray& t2, double cos_t,
         f.n2[k] = (t1[k] - cos_t * t2[k]) / sin_t;
         double dt = std::fabs(t2[k] - t1[k]);
         if (dt > 0) f.turn = std::min(f.turn, lim.acc_mm_s2[k] / dt);
-        f.shift = std::max(f.shift,
-                           std::max(std::fabs(f.n1[k]), std::fabs(f.n2[k])) / lim.acc_mm_s2[k]);
+        f.shift =
+            std::max(f.shift, std::max(std::fabs(f.n1[k]), std::fabs(f.n2[k])) / lim.acc_mm_s2[k]);
     }
     return f;
+}
+
+// The first cut an offset corner tries: no longer than the parabola may be with its middle
+// `share` tol inside the corner, nor than the speed both moves allow needs.
+double offset_first_cut(double share, double tol, double sin_angle, double l_speed_mm) {
+    return std::min(2 * share * tol / (kParabolaDeviationPerL * sin_angle),
+                    std::max(l_speed_mm, kSpeedCutFloor * tol));
+}
+
+// An offset corner's cuts for a turn cut lp whose middle lies `share` tol inside the corner,
+// between moves carried d outwards (only as far as that cut needs: each mm of offset lengthens
+// the path by 2 tan(angle / 2)); `back` = d tan(angle / 2). The shifts are cut so that they
+// pass at kShiftSpeedFactor times the turn's speed on kShiftCentripetal of the acceleration
+// (a shift's sideways second derivative peaks at 6 d / ls^2), within the room the two moves
+// leave them (room1 before the corner, room2 after); a much shorter shift caps the speed on the
+// way into the corner and costs more than the corner gains, so then there are no cuts (false).
+struct OffsetCuts {
+    double d, back, ls1, ls2, before_mm, after_mm;
+};
+
+bool offset_cuts(double lp, double share, double tol, double sin_angle, double cos_t, double sin_t,
+                 const OffsetFrame& f, double room1, double room2, OffsetCuts& c) {
+    c.d = std::clamp(lp * kParabolaDeviationPerL * sin_angle - share * tol, kOffsetMinShare * tol,
+                     share * tol);
+    c.back = c.d * (1 - cos_t) / sin_t;
+    if (!(lp > c.back)) return false;
+    const double v_corner_mm_s = std::sqrt(2 * lp * f.turn);
+    const double ls =
+        kShiftSpeedFactor * v_corner_mm_s * std::sqrt(6 * c.d * f.shift / kShiftCentripetal);
+    c.ls1 = std::min(ls, room1 - (lp - c.back));
+    c.ls2 = std::min(ls, room2 - (lp - c.back));
+    const double keep = kShiftMinSpeedFactor / kShiftSpeedFactor;
+    if (c.ls1 < keep * ls || c.ls2 < keep * ls) return false;
+    c.before_mm = lp - c.back + c.ls1, c.after_mm = lp - c.back + c.ls2;
+    return true;
 }
 
 }  // namespace
@@ -442,32 +477,18 @@ bool Planner::offset_corner(const Piece& p, const Piece& next, double sin_angle,
     if (cos_t < kOffsetMinCos) return false;
     const double sin_t = std::sqrt(std::max(0.0, 1 - cos_t * cos_t));
     const double tol = p.tolerance_mm;
-    // The parabola may now lie up to d + kOffsetShare tol from the offset lines; it is cut no
-    // longer than the speed both moves allow needs, and the offset is only as large as that cut
-    // needs (each mm of offset lengthens the path by 2 tan(angle / 2)).
-    const double lp = std::min(2 * kOffsetShare * tol / (kParabolaDeviationPerL * sin_angle),
-                               std::max(l_speed_mm, kSpeedCutFloor * tol));
-    const double d = std::clamp(lp * kParabolaDeviationPerL * sin_angle - kOffsetShare * tol,
-                                kOffsetMinShare * tol, kOffsetShare * tol);
-    const double back = d * (1 - cos_t) / sin_t;  // d tan(angle / 2)
-    if (!(lp > back)) return false;
-    // The parabola's speed (second derivative (t2 - t1) / 2 lp), and the shift length that
-    // lets a shift pass at kShiftSpeedFactor times it on kShiftCentripetal of the acceleration
-    // (a shift's sideways second derivative peaks at 6 d / ls^2). A much shorter shift caps
-    // the speed on the way into the corner and costs more than the corner gains.
+    // The parabola may now lie up to d + kOffsetShare tol from the offset lines. Room for the
+    // shifts: what the first line has left after the corner at its start (known by now), half
+    // of the second (the corner at its end may take the other half).
     const OffsetFrame f = offset_frame(t1, t2, cos_t, sin_t, cfg_.limits);
     const AxisArray &n1 = f.n1, &n2 = f.n2;
-    const double turn = f.turn, shift = f.shift;
-    const double v_corner_mm_s = std::sqrt(2 * lp * turn);
-    const double ls =
-        kShiftSpeedFactor * v_corner_mm_s * std::sqrt(6 * d * shift / kShiftCentripetal);
-    // Room for the shifts: what the first line has left after the corner at its start (known
-    // by now), half of the second (the corner at its end may take the other half).
-    const double ls1 = std::min(ls, p.geom.length_mm - p.trim_start_mm - (lp - back));
-    const double ls2 = std::min(ls, max_trim_mm(next.geom, 0) - (lp - back));
-    const double keep = kShiftMinSpeedFactor / kShiftSpeedFactor;
-    if (ls1 < keep * ls || ls2 < keep * ls) return false;
-    const double cut_before_mm = lp - back + ls1, cut_after_mm = lp - back + ls2;
+    const double lp = offset_first_cut(kOffsetShare, tol, sin_angle, l_speed_mm);
+    OffsetCuts cuts;
+    if (!offset_cuts(lp, kOffsetShare, tol, sin_angle, cos_t, sin_t, f,
+                     p.geom.length_mm - p.trim_start_mm, max_trim_mm(next.geom, 0), cuts))
+        return false;
+    const double d = cuts.d, ls1 = cuts.ls1, ls2 = cuts.ls2;
+    const double cut_before_mm = cuts.before_mm, cut_after_mm = cuts.after_mm;
     // The offset corner c2 is d from both lines, outwards; a0 and b3 lie on the programmed lines.
     AxisArray c2, a0, a3, b0, b3;
     for (int k = 0; k < kAxes; ++k) {
@@ -599,7 +620,6 @@ bool Planner::offset_arc_corner(const Piece& p, const Piece& next, double sin_an
         if (e->kind == ElementKind::Arc && !(e->radius_mm > 2 * tol)) return false;
     const OffsetFrame f = offset_frame(t1, t2, cos_t, sin_t, cfg_.limits);
     const AxisArray &n1 = f.n1, &n2 = f.n2;
-    const double turn = f.turn, shift = f.shift;
     // Room for the shifts: a line before the corner may give all it has left after the corner
     // at its start, an arc kMaxArcTrimShare of itself; the move after, what max_trim_mm allows.
     const double L1 = p.geom.length_mm;
@@ -608,34 +628,16 @@ bool Planner::offset_arc_corner(const Piece& p, const Piece& next, double sin_an
     const double room2 = max_trim_mm(next.geom, 0);
     // The Bezier blend inside the corner may cut this much: a shorter offset cut gains nothing.
     const double l_inside = tol / (kParabolaDeviationPerL * sin_angle);
-    // The cuts for a turn cut lp, whose middle lies `share` tol inside the corner, from moves
-    // carried d = lp / 4 sin(angle) - share tol outwards (as between two lines).
-    struct Cuts {
-        double d, back, ls1, ls2, before_mm, after_mm;
-    };
-    auto cuts_for = [&](double lp, double share, Cuts& c) {
-        c.d = std::clamp(lp * kParabolaDeviationPerL * sin_angle - share * tol,
-                         kOffsetMinShare * tol, share * tol);
-        c.back = c.d * (1 - cos_t) / sin_t;  // d tan(angle / 2)
-        if (!(lp > c.back)) return false;
-        const double v_corner_mm_s = std::sqrt(2 * lp * turn);
-        const double ls =
-            kShiftSpeedFactor * v_corner_mm_s * std::sqrt(6 * c.d * shift / kShiftCentripetal);
-        c.ls1 = std::min(ls, room1 - (lp - c.back));
-        c.ls2 = std::min(ls, room2 - (lp - c.back));
-        const double keep = kShiftMinSpeedFactor / kShiftSpeedFactor;
-        if (c.ls1 < keep * ls || c.ls2 < keep * ls) return false;
-        c.before_mm = lp - c.back + c.ls1, c.after_mm = lp - c.back + c.ls2;
-        return true;
+    auto cuts_for = [&](double lp, double share, OffsetCuts& c) {
+        return offset_cuts(lp, share, tol, sin_angle, cos_t, sin_t, f, room1, room2, c);
     };
     auto first_cut = [&](double share) {
-        return std::min(2 * share * tol / (kParabolaDeviationPerL * sin_angle),
-                        std::max(l_speed_mm, kSpeedCutFloor * tol));
+        return offset_first_cut(share, tol, sin_angle, l_speed_mm);
     };
     // The path is cut into chords once, for the longest cuts tried; an arc's chords leave a
     // slack (the arc's distance from them) that the shift and the turn must keep clear of, so
     // both use that much less of the tolerance.
-    Cuts c;
+    OffsetCuts c;
     if (!cuts_for(first_cut(kOffsetShare), kOffsetShare, c)) return false;
     const CornerPath path = corner_path(p.geom, c.before_mm, next.geom, c.after_mm, tol);
     double slack_mm = 0;
