@@ -101,10 +101,6 @@ std::string ProgramRunner::error() const {
     return error_;
 }
 
-std::string ProgramRunner::where() const {
-    if (last_loc_.line == 0) return cfg_.program_path;
-    return fmt::format("{}:{}:{}", last_loc_.file, last_loc_.line, last_loc_.col);
-}
 
 bool ProgramRunner::stopping() noexcept {
     if (link_.abort_requested()) abort_.store(true, std::memory_order_relaxed);
@@ -157,7 +153,8 @@ bool ProgramRunner::deliver() noexcept {
 
 // The end record goes last; done/failed are set before it can reach the consumer, so whoever
 // sees the machine stop after the program's end also sees why.
-void ProgramRunner::finish(const std::string& error, const interp::Error* located) {
+void ProgramRunner::finish(const std::string& error, const interp::SourceLoc* place,
+                           std::string_view cause) {
     if (error.empty()) {
         done_.store(true, std::memory_order_release);
     } else {
@@ -168,15 +165,28 @@ void ProgramRunner::finish(const std::string& error, const interp::Error* locate
         failed_.store(true, std::memory_order_release);
     }
     scratch_.clear();
-    if (located)
-        encoder_.end({located->file(), located->line(), located->col()}, located->reason(),
-                     scratch_);
+    if (place)
+        encoder_.end(*place, cause, scratch_);
     else
         encoder_.end(error, scratch_);
     outbox_.insert(outbox_.end(), scratch_.begin(), scratch_.end());
     finished_ = true;
     running_.store(false, std::memory_order_relaxed);
     link_.on_progress();
+}
+
+void ProgramRunner::fail_with(const interp::Error& e) {
+    const interp::SourceLoc place{e.file(), e.line(), e.col()};
+    finish(e.what(), &place, e.reason());
+}
+
+// Stopped or aborted before the program's end: the place is the last command sent (what the
+// machine was doing), or the program itself when nothing was sent yet.
+void ProgramRunner::give_up(std::string_view why) {
+    const std::string cause = fmt::format("{}; the rest of the program is given up", why);
+    if (last_loc_.line == 0) return finish(fmt::format("{}: {}", cfg_.program_path, cause));
+    finish(fmt::format("{}:{}:{}: {}", last_loc_.file, last_loc_.line, last_loc_.col, cause),
+           &last_loc_, cause);
 }
 
 void ProgramRunner::open_program() {
@@ -193,7 +203,7 @@ void ProgramRunner::run() noexcept {
         try {
             open_program();
         } catch (const interp::Error& e) {
-            finish(e.what(), &e);
+            fail_with(e);
         } catch (const std::exception& e) {
             finish(e.what());
         }
@@ -209,18 +219,18 @@ void ProgramRunner::run() noexcept {
         link_.on_progress();
         if (stopping()) {
             if (worker_.pause_requested()) break;
-            finish(fmt::format("{}: aborted; the rest of the program is given up", where()));
+            give_up("aborted");
             continue;
         }
         try {
             if (!interpreter_->step()) finish("");
         } catch (const Stopped&) {
             // The block that asked could not be finished: the rest of the program is given up.
-            finish(fmt::format(
-                "{}: {} while waiting for the machine; the rest of the program is given up",
-                where(), abort_.load(std::memory_order_relaxed) ? "aborted" : "stopped"));
+            give_up(abort_.load(std::memory_order_relaxed)
+                        ? "aborted while waiting for the machine"
+                        : "stopped while waiting for the machine");
         } catch (const interp::Error& e) {
-            finish(e.what(), &e);
+            fail_with(e);
         } catch (const std::exception& e) {
             finish(e.what());
         }

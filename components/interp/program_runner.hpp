@@ -110,11 +110,14 @@ class ProgramRunner {
     void run() noexcept;
     void open_program();
     bool deliver() noexcept;  // outbox -> stream as far as it fits; true when all went
-    // `located`, if given, is the error with its place, which the end record carries apart.
-    void finish(const std::string& error, const interp::Error* located = nullptr);
+    // `error` whole ("" = the program completed); with a place, the end record carries the
+    // place and the cause apart, so the consumer can name the line without parsing the text.
+    void finish(const std::string& error, const interp::SourceLoc* place = nullptr,
+                std::string_view cause = {});
+    void fail_with(const interp::Error& e);
+    void give_up(std::string_view why);
     void mark_ready();
     bool stopping() noexcept;
-    std::string where() const;  // "file:line:col" of the last command sent, or the program
 
     RunnerConfig cfg_;
     MachineLink& link_;

@@ -2,6 +2,7 @@
 // that decodes what is sent: a queue-busting read sends a barrier and waits until the machine
 // says it reached it, then reads the live position; without a machine (standalone) it reads
 // the model; an abort while waiting gives the program up with file:line:col.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -43,6 +44,9 @@ class FakeMachine : public interpcomp::MachineLink {
                 }
                 case interp::wire::Decoder::Item::End:
                     lines_.push_back(decoder_.failed() ? "end failed: " + decoder_.error() : "end");
+                    if (const auto& at = decoder_.error_loc())
+                        end_place_ = fmt::format("{}:{} {}", at->line, at->col,
+                                                 decoder_.error_cause());
                     break;
                 case interp::wire::Decoder::Item::None:
                     break;
@@ -71,6 +75,11 @@ class FakeMachine : public interpcomp::MachineLink {
         std::lock_guard lock(mutex_);
         return lines_;
     }
+    // "line:col cause" of an end record that carries its place apart, else empty.
+    std::string end_place() const {
+        std::lock_guard lock(mutex_);
+        return end_place_;
+    }
     std::atomic<bool> abort_{false};
     std::atomic<double> z_mm_{0};
     std::atomic<bool> tripped_{true};
@@ -79,6 +88,7 @@ class FakeMachine : public interpcomp::MachineLink {
     mutable std::mutex mutex_;
     interp::wire::Decoder decoder_;
     std::vector<std::string> lines_;
+    std::string end_place_;
     std::uint32_t barriers_sent_ = 0;
     std::size_t capacity_ = 1'000'000;
     std::atomic<std::uint32_t> reached_{0};
@@ -165,6 +175,8 @@ TEST(ProgramRunner, AbortWhileWaitingGivesTheProgramUpWithItsLocation) {
                                   "program is given up");
     const auto lines = machine.lines();
     EXPECT_EQ(lines.back(), "end failed: " + runner.error());
+    EXPECT_EQ(machine.end_place(),
+              "2:1 aborted while waiting for the machine; the rest of the program is given up");
 }
 
 TEST(ProgramRunner, ASyntaxErrorFailsBeforeStartReturns) {
@@ -173,6 +185,7 @@ TEST(ProgramRunner, ASyntaxErrorFailsBeforeStartReturns) {
     ProgramRunner runner(RunnerConfig{prog.path(), {}, false}, machine);
     EXPECT_TRUE(runner.start_and_wait_ready());
     EXPECT_EQ(runner.error(), prog.path() + ":3:8: expected a number or '=' after Q");
+    EXPECT_EQ(machine.end_place(), "3:8 expected a number or '=' after Q");
     const auto lines = machine.lines();
     ASSERT_FALSE(lines.empty());
     EXPECT_EQ(lines.back(), "end failed: " + runner.error());
