@@ -471,7 +471,40 @@ double Sampler::advance_rate_jerk(double target, double dt) noexcept {
         rdd_ = 0;
         return r_ * dt;
     }
-    const RateLimits room = jerk_room_limits(target, dt);
+    double vm_acc = 0;
+    const RateLimits room = jerk_room_limits(target, dt, &vm_acc);
+    if (target < r_ && target < 1 && r_ <= kPlannedRate) {
+        // Slowing: r'' against the plan's jerk has the room that jerk leaves on its other
+        // side, and the backup brakes r' where the falling rate has made room (coast_backup()).
+        const double pad = r_ * dt + kWalkPadS;
+        RateSpan box{std::max(0.0, r_ + std::min(rd_, 0.0) * dt), r_, rd_, rd_, 0};
+        WalkFrom at0;
+        const double am0 = signed_jerk_room(tau_, tau_ + pad, box, at0).down;
+        box.rd_lo = rd_ - am0 * dt;
+        box.r_lo = std::max(0.0, r_ + box.rd_lo * dt);
+        WalkFrom at1;
+        const double am1 = std::min(am0, signed_jerk_room(tau_, tau_ + pad, box, at1).down);
+        if (am1 > room.max_rate_per_s2) {
+            const RateLimits lim{vm_acc, am1};
+            RatePath move;
+            rate_path({r_, rd_}, target, dt, lim, move);
+            RateState end{r_, rd_};
+            double tau_end = tau_;
+            for (int i = 0; i < move.count; ++i)
+                tau_end += step_rate(end, move.pieces[static_cast<std::size_t>(i)]);
+            RatePath backup;
+            if (coast_backup(end.r, end.rd, tau_end, am1, backup)) {
+                RatePath whole = move;
+                for (int i = 0; i < backup.count; ++i)
+                    whole.add(backup.pieces[static_cast<std::size_t>(i)]);
+                if (whole.count < RatePath::kMaxPieces && rate_path_safe(whole)) {
+                    cert_ = backup;
+                    last_limits_ = lim;
+                    return apply_rate(move);
+                }
+            }
+        }
+    }
     for (double scale : {1.0, 0.25}) {
         const RateLimits lim{room.max_rate_per_s * scale, room.max_rate_per_s2 * scale};
         RatePath move;
@@ -555,7 +588,7 @@ Sampler::Walk Sampler::walk_phases(double from, double to, WalkFrom& at, Visit&&
 //   (the v r'' term).
 // Never below the fixed bounds (valid anywhere at r <= 1); only a proposal: rate_path_safe()
 // decides.
-RateLimits Sampler::jerk_room_limits(double target, double dt) noexcept {
+RateLimits Sampler::jerk_room_limits(double target, double dt, double* vm_acc_out) noexcept {
     const double vm0 = last_limits_.max_rate_per_s, am0 = last_limits_.max_rate_per_s2;
     // The highest rate the move and its brake may reach: r' at most vm0 more for that long.
     double reach_s = dt + vm0 / am0;
@@ -571,7 +604,7 @@ RateLimits Sampler::jerk_room_limits(double target, double dt) noexcept {
     const Span r2_span = r_span * r_span;
     const AxisLimits& lim = cfg_.limits;
     const double js = cfg_.junction_share;
-    double vm = kInf, am = kInf;
+    double vm = kInf, am = kInf, vm_acc_all = kInf;
     auto visit = [&](const PreparedSegment& rec, const ElementBounds& b, const ProfilePhase& ph,
                      double t_lo, double t_hi, double dur) {
         const double keep = 1 - cfg_.override_reserve - (rec.rough ? js : 0);
@@ -600,6 +633,7 @@ RateLimits Sampler::jerk_room_limits(double target, double dt) noexcept {
             const double symmetric = (m - use.acc * r_hi * r_hi) / use.vel;
             const double vm_acc = std::max(signed_room, symmetric);
             vm = std::min(vm, vm_acc);
+            vm_acc_all = std::min(vm_acc_all, vm_acc);
             if (lim.jerk_mm_s3[k] <= 0) continue;
             const double mj = free_j * lim.jerk_mm_s3[k];
             const double left = mj - use.jerk * r_hi * r_hi * r_hi;
@@ -637,7 +671,10 @@ RateLimits Sampler::jerk_room_limits(double target, double dt) noexcept {
         const RateLimits beyond = unknown_room(r_hi);  // only the planner's guarantees
         vm = std::min(vm, beyond.max_rate_per_s);
         am = std::min(am, beyond.max_rate_per_s2);
+        vm_acc_all = std::min(vm_acc_all, beyond.max_rate_per_s);
     }
+    if (vm_acc_out)
+        *vm_acc_out = std::clamp(vm_acc_all, rl_.max_rate_per_s, cfg_.max_rate / kRateRampS);
     // Where nothing moves any rate change fits; the ramps stay finite (kRateRampS) anyway.
     vm = std::clamp(vm, rl_.max_rate_per_s, cfg_.max_rate / kRateRampS);
     am = std::clamp(am, rl_.max_rate_per_s2, std::max(vm / kRateRampS, rl_.max_rate_per_s2));
@@ -674,6 +711,129 @@ bool Sampler::rate_path_safe(const RatePath& path) noexcept {
         tau += dtau;
     }
     return s.rd == 0 && s.r <= kPlannedRate;
+}
+
+// Per axis (the terms added, valid on any element): |j_t| g1 + 3 u |a_t| g2 + u^3 g3 <= J, so
+// j_t = j r^3 + 3 a r r' + v r'' may range over +-m with m = (J - 3 u |a_t| g2 - u^3 g3) / g1.
+// With the plan's terms j r^3 + 3 a r r' as a signed range [lo, hi], r'' > 0 has (m - hi) / v
+// and r'' < 0 has (m + lo) / v: against the plan's jerk nearly 2 J, with it what is left.
+Sampler::SignedRoom Sampler::signed_jerk_room(double from, double to, const RateSpan& box,
+                                              WalkFrom& at) noexcept {
+    const AxisLimits& lim = cfg_.limits;
+    const double js = cfg_.junction_share;
+    const double r_hi = std::max(box.r_hi, 0.0);
+    RateSpan no_rdd = box;
+    no_rdd.rdd = 0;
+    double up = kInf, down = kInf, up_min = 0, down_min = 0;
+    auto visit = [&](const PreparedSegment& rec, const ElementBounds& b, const ProfilePhase& ph,
+                     double t_lo, double t_hi, double) {
+        const PlanSpan pl = plan_span(ph, t_lo, t_hi);
+        const double v_hi = pl.v.abs_max(), v_lo = std::max(pl.v.lo, 0.0);
+        if (v_hi <= 1e-12) return true;  // nothing moves: any r'' fits
+        const double free_j = 1 - (rec.rough ? js * r_hi * r_hi : 0);
+        const PathLoad load = path_load(pl, no_rdd);
+        const double u = load.u.abs_max(), a_t = load.at.abs_max();
+        for (int q = 0; q < b.axis_count; ++q) {
+            const int k = b.axes[q];
+            if (lim.jerk_mm_s3[k] <= 0 || b.g1[k] <= 1e-12) continue;
+            const double m =
+                (free_j * lim.jerk_mm_s3[k] - 3 * u * a_t * b.g2[k] - u * u * u * b.g3[k]) /
+                b.g1[k];
+            up = std::min(up, (m - load.jt.hi) / v_hi);
+            down = std::min(down, (m + load.jt.lo) / v_hi);
+            // Where the plan's terms alone pass one side, r'' must pull them back by at least
+            // the excess, at the lowest speed.
+            if (load.jt.lo < -m)
+                up_min = std::max(up_min, v_lo > 0 ? (-m - load.jt.lo) / v_lo : kInf);
+            if (load.jt.hi > m)
+                down_min = std::max(down_min, v_lo > 0 ? (load.jt.hi - m) / v_lo : kInf);
+        }
+        return true;
+    };
+    if (walk_phases(from, to, at, visit) == Walk::Unknown) {
+        const double beyond = unknown_room(r_hi).max_rate_per_s2;
+        up = std::min(up, beyond);
+        down = std::min(down, beyond);
+    }
+    return {std::max(up, 0.0), std::max(down, 0.0), up_min, down_min};
+}
+
+// Each piece halves r' (the last lands it on 0) at the room of the stretch it covers, guessed
+// from the previous piece's |r''| (am_hint for the first) and taken again over the range that
+// gives; with no room to brake while the rate falls, a piece coasts until r has fallen by a
+// quarter (the plan's j r^3 shrinks with it).
+bool Sampler::coast_backup(double r, double rd, double tau, double am_hint,
+                           RatePath& out) noexcept {
+    constexpr int kMaxBrakePieces = 12;
+    const double floor = rl_.max_rate_per_s2;
+    const double cap = cfg_.max_rate / (kRateRampS * kRateRampS);
+    double am = std::clamp(am_hint, floor, cap);
+    WalkFrom at;
+    int n = 0;
+    while (rd != 0) {
+        if (n++ >= kMaxBrakePieces) return false;
+        const double mag = std::fabs(rd);
+        // The |r''| range of the piece that removes `frac` of r' at |r''| = guess, over the
+        // stretch and the rates it covers (the larger the guess, the shorter the piece).
+        auto room_at = [&](double guess, double frac, double& h) {
+            h = frac * mag / guess;
+            const double rd_to = rd * (1 - frac);
+            const RateSpan box{std::max(0.0, r - std::max(-rd, 0.0) * h),
+                               r + std::max(rd, 0.0) * h, std::min(rd, rd_to),
+                               std::max(rd, rd_to), 0};
+            WalkFrom probe = at;
+            const SignedRoom room =
+                signed_jerk_room(tau, tau + box.r_hi * h + kWalkPadS, box, probe);
+            // A hair inside: at the edge itself the check's sums round either way.
+            return rd < 0 ? Span{room.up_min * (1 + 1e-6), std::min(room.up * (1 - 1e-6), cap)}
+                          : Span{room.down_min * (1 + 1e-6), std::min(room.down * (1 - 1e-6), cap)};
+        };
+        // A room reaching the guess covers the piece it was taken over (a larger |r''| only
+        // shortens it); a smaller one is the next guess; a stretch that needs more than it
+        // allows (the plan's jerk turns round inside it) is cut shorter.
+        double frac = mag <= am * 2e-3 || n >= kMaxBrakePieces - 1 ? 1.0 : 0.5;
+        double guess = am, h = 0, pick = -1;
+        Span got{};
+        for (int it = 0; it < 6 && pick < 0; ++it) {
+            got = room_at(guess, frac, h);
+            if (got.hi < floor) break;
+            if (got.lo > got.hi) {
+                frac /= 2;
+            } else if (got.hi >= guess) {
+                pick = got.hi;
+            } else {
+                guess = std::max(got.lo, it < 2 ? got.hi : 0.9 * got.hi);
+            }
+        }
+        if (pick < 0) {
+            // No room to brake r': coast while the rate falls, which makes room.
+            if (got.hi >= floor || got.lo > 0 || rd > 0 || r <= 0) return false;
+            const RatePiece pc{0, 0.25 * r / mag, false, -1};
+            RateState s{r, rd};
+            tau += step_rate(s, pc);
+            r = s.r;
+            out.add(pc);
+            if (out.count >= RatePath::kMaxPieces - 3) return false;
+            continue;
+        }
+        am = pick;
+        const bool land = frac == 1.0;
+        const RatePiece pc{rd < 0 ? am : -am, frac * mag / am, land, -1};
+        RateState s{r, rd};
+        tau += step_rate(s, pc);
+        r = s.r;
+        rd = land ? 0.0 : s.rd;
+        out.add(pc);
+        if (out.count >= RatePath::kMaxPieces - 3) return false;
+    }
+    if (r < -1e-12) return false;
+    const double over = r - 1;
+    if (over <= 0) return true;
+    // Above 1: down to 1 at the fixed bounds (valid at any rate the caps allow).
+    RatePath down;
+    if (!brake_path({r, 0}, rl_, down)) return false;
+    for (int i = 0; i < down.count; ++i) out.add(down.pieces[static_cast<std::size_t>(i)]);
+    return out.count < RatePath::kMaxPieces;
 }
 
 // Axis k sees at most the smaller of two bounds, both over the part of each phase the stretch
@@ -742,23 +902,30 @@ bool Sampler::stretch_safe(double from, double to, const RateSpan& box, WalkFrom
 //     3 r (1 - reserve) A |r'| + V |r''| <= J (1 - (1 - reserve) r^3 - share r^2 (1 - r))
 // (the rough case's larger left side and the other's, the smaller right side). At r = 1 this is
 // the fixed reserve bounds (rate_limits()); as the rate falls it grows, so a stop that runs
-// past what the ring holds need not crawl at 1 % of the acceleration.
-bool Sampler::unknown_safe(const RateSpan& box) const noexcept {
+// past what the ring holds need not crawl at 1 % of the acceleration. Both sides are worst at
+// the box's highest rate (the left grows with r, the right falls as long as the reserve's keep
+// exceeds the junction share), so r_hi alone decides.
+bool rate_fits_any_record(const SamplerConfig& cfg, const RateLimits& fixed,
+                          const RateSpan& box) noexcept {
     if (box.r_hi > kPlannedRate) return false;
     const double rd = std::max(std::fabs(box.rd_lo), std::fabs(box.rd_hi));
     const double rdd = std::fabs(box.rdd);
-    if (rd <= rl_.max_rate_per_s && rdd <= rl_.max_rate_per_s2) return true;  // the fixed bounds
-    const double r = std::clamp(box.r_hi, 0.0, 1.0), keep = 1 - cfg_.override_reserve;
-    const double js = cfg_.junction_share;
+    if (rd <= fixed.max_rate_per_s && rdd <= fixed.max_rate_per_s2) return true;  // fixed bounds
+    const double r = std::clamp(box.r_hi, 0.0, 1.0), keep = 1 - cfg.override_reserve;
+    const double js = cfg.junction_share;
     const double acc_left = 1 - keep * r * r - js * r * (1 - r);
     const double jerk_left = 1 - keep * r * r * r - js * r * r * (1 - r);
-    const AxisLimits& lim = cfg_.limits;
+    const AxisLimits& lim = cfg.limits;
     for (int k = 0; k < kAxes; ++k) {
         const double v = lim.vel_mm_s[k], a = lim.acc_mm_s2[k], j = lim.jerk_mm_s3[k];
         if (v * rd > a * acc_left) return false;
         if (j > 0 && 3 * r * keep * a * rd + v * rdd > j * jerk_left) return false;
     }
     return true;
+}
+
+bool Sampler::unknown_safe(const RateSpan& box) const noexcept {
+    return rate_fits_any_record(cfg_, rl_, box);
 }
 
 // The proposal's bounds where the stretch runs past the ring: unknown_safe()'s room at rates

@@ -13,6 +13,8 @@
 //                                            1e5 mm/s^3; prints a hash of every sample, so two
 //                                            builds can be shown to sample identically; exits 1
 //                                            if a run leaves the axis limits or does not finish.
+//   bench_sampler --holds                    how soon jerk-limited holds and override steps take
+//                                            effect (holds.cpp), on a simulated clock.
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
@@ -26,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "holds.hpp"
 #include "motion/planner.hpp"
 #include "motion/sampler.hpp"
 #include "ngc_program.hpp"
@@ -259,6 +262,7 @@ int digest_main(int argc, char** argv) {
 int main(int argc, char** argv) {
     try {
         if (argc >= 2 && std::strcmp(argv[1], "--digest") == 0) return digest_main(argc, argv);
+        if (argc == 2 && std::strcmp(argv[1], "--holds") == 0) return sampler_holds::holds_main();
         benchmark::Initialize(&argc, argv);
         if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
         register_cost_cases();

@@ -1,0 +1,10 @@
+// bench_sampler --holds (holds.cpp): the table of jerk-limited hold and override response times.
+#pragma once
+
+namespace sampler_holds {
+// Prints the table; 1 if a run left the axis limits or a hold never ended.
+int holds_main();
+// The shortest stop from path speed u0 and tangential acceleration a0 under |a| <= acc and
+// |jerk| <= jerk (at rest with a = 0): a lower bound for any hold from that state.
+double shortest_stop_s(double u0, double a0, double acc, double jerk);
+}  // namespace sampler_holds
