@@ -16,16 +16,13 @@ class PhaseWriter {
   public:
     explicit PhaseWriter(Profile1D& p) : p_(p) {}
 
+    // Jerk-limited (lim.jerk_mm_s3 > 0): +J, (0), -J.
     void ramp(double v0, double v1, const TangentLimits& lim) {
         double dv = v1 - v0;
         if (dv == 0) return;
         double sign = dv > 0 ? 1.0 : -1.0;
         dv = std::fabs(dv);
         double a = lim.acc_mm_s2;
-        if (!jerk_limited(lim)) {
-            push(sign * a, 0, dv / a);
-            return;
-        }
         double j = lim.jerk_mm_s3;
         if (dv >= a * a / j) {
             push(0, sign * j, a / j);
@@ -38,6 +35,15 @@ class PhaseWriter {
         }
         v_ = v1;  // removes the rounding drift of the integrated speed
         a_ = 0;
+    }
+
+    // Jerk-unlimited: constant +-a for t_s = |v1 - v0| / a, which the caller has computed
+    // already (trapezoid_ramps).
+    void ramp_unlimited(double v0, double v1, double a, double t_s) {
+        double dv = v1 - v0;
+        if (dv == 0) return;
+        double sign = dv > 0 ? 1.0 : -1.0;
+        push(sign * a, 0, t_s);
     }
 
     void cruise(double duration) { push(0, 0, duration); }
@@ -80,6 +86,49 @@ double peak_speed_for_length(double length, double v_in, double v_out, double lo
     auto b = detail::illinois(excess, lo, flo, hi, fhi, 1e-14 * hi,
                               [&](double, double f) { return std::fabs(f) <= tol && f <= 0; });
     return b.lo;
+}
+
+// The two ramps of a trapezoid from v_in to the peak vp and on to v_out at acceleration a:
+// their times and the length they need, computed with the operations of ramp_time_s() and
+// ramp_distance_mm() (needed = ramp_distance_mm(v_in, vp) + ramp_distance_mm(vp, v_out)), so
+// the profile is the one those give. Each is computed once: the length decides the peak and the
+// cruise, the times are the ramps' phases.
+struct TrapezoidRamps {
+    double t_in_s, t_out_s, needed_mm;
+};
+
+TrapezoidRamps trapezoid_ramps(double v_in, double vp, double v_out, double a) {
+    TrapezoidRamps r;
+    r.t_in_s = std::fabs(vp - v_in) / a;
+    r.t_out_s = std::fabs(v_out - vp) / a;
+    r.needed_mm = (v_in + vp) / 2 * r.t_in_s + (vp + v_out) / 2 * r.t_out_s;
+    return r;
+}
+
+// build_profile_into() without a jerk limit: the same decisions on the same values (the peak
+// at the cap, at the larger end speed, or where the two ramps meet), each ramp's time and
+// length computed once instead of in every needed() and again in ramp().
+void build_trapezoid_into(Profile1D& prof, double length, double v_in, double v_out, double vcap,
+                          double a) {
+    const double lo = std::max(v_in, v_out);
+    double vpeak = vcap;
+    TrapezoidRamps r;
+    if (vpeak <= lo) {
+        vpeak = lo;
+        r = trapezoid_ramps(v_in, vpeak, v_out, a);
+    } else if ((r = trapezoid_ramps(v_in, vpeak, v_out, a)).needed_mm > length) {
+        vpeak = std::sqrt((2 * a * length + v_in * v_in + v_out * v_out) / 2);
+        vpeak = std::clamp(vpeak, lo, vcap);
+        r = trapezoid_ramps(v_in, vpeak, v_out, a);
+    }
+    PhaseWriter w(prof);
+    w.start(v_in);
+    w.ramp_unlimited(v_in, vpeak, a, r.t_in_s);
+    double cruise_mm = length - r.needed_mm;
+    if (vpeak > 0 && cruise_mm > 0) w.cruise(cruise_mm / vpeak);
+    w.ramp_unlimited(vpeak, v_out, a, r.t_out_s);
+    prof.duration_s = w.time();
+    prof.peak_v_mm_s = vpeak;
 }
 
 }  // namespace
@@ -146,6 +195,8 @@ Profile1D build_profile(double length, double v_in, double v_out, double vcap,
 
 void build_profile_into(Profile1D& prof, double length, double v_in, double v_out, double vcap,
                         const TangentLimits& lim) noexcept {
+    if (!jerk_limited(lim))
+        return build_trapezoid_into(prof, length, v_in, v_out, vcap, lim.acc_mm_s2);
     double lo = std::max(v_in, v_out);
     double vpeak = vcap;
     auto needed = [&](double vp) {
@@ -156,13 +207,7 @@ void build_profile_into(Profile1D& prof, double length, double v_in, double v_ou
     if (vpeak <= lo) {
         vpeak = lo;
     } else if ((needed_at_cap = needed(vpeak)) > length) {
-        if (!jerk_limited(lim)) {
-            double a = lim.acc_mm_s2;
-            vpeak = std::sqrt((2 * a * length + v_in * v_in + v_out * v_out) / 2);
-            vpeak = std::clamp(vpeak, lo, vcap);
-        } else {
-            vpeak = peak_speed_for_length(length, v_in, v_out, lo, vpeak, lim);
-        }
+        vpeak = peak_speed_for_length(length, v_in, v_out, lo, vpeak, lim);
     } else {
         at_cap = true;
     }
