@@ -25,6 +25,13 @@ class CoreXYWithExtras final : public motion::Kinematics {
         core_.forward(joints.first(3), axes);
         for (std::size_t j = 3; j < axes_.size(); ++j) axes[axes_[j]] = joints[j];
     }
+    std::vector<motion::AxisArray> linear_map() const override {
+        std::vector<motion::AxisArray> rows = core_.linear_map();
+        rows.resize(axes_.size(), motion::AxisArray{});
+        for (std::size_t j = 3; j < axes_.size(); ++j)
+            rows[j][static_cast<std::size_t>(axes_[j])] = 1;
+        return rows;
+    }
 
   private:
     motion::CoreXYKinematics core_;

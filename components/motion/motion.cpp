@@ -150,6 +150,7 @@ class Motion : public hal::Instance {
             return;
         }
         motion::PlannerConfig plan = planner_config();
+        joints_planned_ = !kins_.kins().linear_map().empty();
         try {
             motion::validate(plan);
         } catch (const std::invalid_argument& e) {
@@ -650,9 +651,10 @@ class Motion : public hal::Instance {
 
     // Joint velocity and acceleration of the commands (backward differences), published on
     // joint.N.vel-cmd / acc-cmd and checked against joint.N.max-velocity / max-acceleration.
-    // The planner limits the axes; a kinematics can still ask more of a motor (a CoreXY motor
-    // runs at X + Y, a tilted table swings the linear joints), so excesses are recorded and
-    // printed at stop, not tripped on.
+    // The planner limits the axes, and the joints too when the kinematics is linear (trivial,
+    // gantry, CoreXY: planner_config()); a nonlinear kinematics can still ask more of a motor
+    // (a tilted table swings the linear joints), so excesses are recorded and printed at stop,
+    // not tripped on.
     void check_joint_motion(double dt, std::int32_t line) noexcept {
         if (!(dt > 0)) return;
         for (std::size_t j = 0; j < joint_count_; ++j) {
@@ -735,10 +737,14 @@ class Motion : public hal::Instance {
                 excess_reported_ = true;
                 fmt::print(stderr,
                            "{}: joint {} was commanded a {} of {:.6g}{} in {} periods (first at "
-                           "line {}), above {} = {:.6g}: the kinematics ask more of this motor "
-                           "than the axis limits allow\n",
+                           "line {}), above {} = {:.6g}: {}\n",
                            name(), j, what, e.peak, per, e.periods, e.first_line,
-                           pin_name(fmt::format("joint.{}.{}", j, param)), e.limit);
+                           pin_name(fmt::format("joint.{}.{}", j, param)), e.limit,
+                           joints_planned_ ? "the planner keeps the motors within the limits "
+                                             "they had at start; one lowered since is only "
+                                             "checked"
+                                           : "the kinematics ask more of this motor than the "
+                                             "axis limits allow");
             };
             say(joint_excess_[j].vel, "velocity", "/s", "max-velocity");
             say(joint_excess_[j].acc, "acceleration", "/s^2", "max-acceleration");
@@ -1031,7 +1037,25 @@ class Motion : public hal::Instance {
         }
         if (!(blend_tolerance_mm_.get() >= 0))
             throw hal::Error(fmt::format("{}: motion.blend-tolerance must be >= 0 mm", name()));
+        add_joint_limits(plan.limits);
         return plan;
+    }
+
+    // A linear kinematics' joints are planned with their limits (joint.N.max-velocity,
+    // max-acceleration, max-jerk; 0 = unlimited), as the axes are with theirs.
+    void add_joint_limits(motion::AxisLimits& limits) const {
+        const std::vector<motion::AxisArray> rows = kins_.kins().linear_map();
+        if (rows.empty()) return;
+        std::vector<motion::JointLimit> joints(joint_count_);
+        for (std::size_t j = 0; j < joint_count_; ++j)
+            joints[j] = {joint_max_velocity_[j].get(), joint_max_acceleration_[j].get(),
+                         joint_max_jerk_[j].get()};
+        try {
+            motion::set_linear_joints(limits, rows, joints);
+        } catch (const std::invalid_argument& e) {
+            throw hal::Error(fmt::format(
+                "{}: joint.N.max-velocity / max-acceleration / max-jerk: {}", name(), e.what()));
+        }
     }
 
     motioncomp::KinsLink kins_;
@@ -1048,11 +1072,15 @@ class Motion : public hal::Instance {
     hal::Array<hal::Param<double>> max_ferror_{this, pin("joint.{}.max-ferror"), joint_count_};
     hal::Array<hal::Out<double>> joint_vel_cmd_{this, pin("joint.{}.vel-cmd"), joint_count_};
     hal::Array<hal::Out<double>> joint_acc_cmd_{this, pin("joint.{}.acc-cmd"), joint_count_};
-    // LinuxCNC's [JOINT_N]MAX_VELOCITY / MAX_ACCELERATION; 0 = not checked.
+    // LinuxCNC's [JOINT_N]MAX_VELOCITY / MAX_ACCELERATION; 0 = unlimited. Planned with when the
+    // kinematics is linear, and checked as commanded (excesses reported at stop).
     hal::Array<hal::Param<double>> joint_max_velocity_{this, pin("joint.{}.max-velocity"),
                                                        joint_count_};
     hal::Array<hal::Param<double>> joint_max_acceleration_{
         this, pin("joint.{}.max-acceleration"), joint_count_};
+    // [JOINT_N]MAX_JERK; 0 = unlimited. Planned with (as the velocity and acceleration limits
+    // are) when the kinematics is linear; not checked as commanded.
+    hal::Array<hal::Param<double>> joint_max_jerk_{this, pin("joint.{}.max-jerk"), joint_count_};
     // LinuxCNC's [JOINT_N]MIN_LIMIT / MAX_LIMIT and its defaults for a joint without them.
     hal::Array<hal::Param<double>> joint_min_limit_{this, pin("joint.{}.min-limit"), joint_count_,
                                                     -1e99};
@@ -1143,6 +1171,7 @@ class Motion : public hal::Instance {
     std::vector<double> joint_vel_mm_s_;
     std::vector<JointExcess> joint_excess_;
     bool joints_primed_ = false;  // joint_prev_mm_ holds a real command
+    bool joints_planned_ = false;  // the planner has the joints' limits (a linear kinematics)
     bool excess_reported_ = false;
     bool enable_now_ = false;      // motion.enable as taken by take_commands() this period
     bool commands_taken_ = false;  // take_commands() ran since the last motion-controller

@@ -46,6 +46,20 @@ void TrivialKinematics::forward(std::span<const double> joints, AxisArray& axes)
     for (std::size_t i = axes_.size(); i-- > 0;) axes[axes_[i]] = joints[i];
 }
 
+std::vector<AxisArray> TrivialKinematics::linear_map() const {
+    std::vector<AxisArray> rows(axes_.size(), AxisArray{});
+    for (std::size_t i = 0; i < axes_.size(); ++i) rows[i][static_cast<std::size_t>(axes_[i])] = 1;
+    return rows;
+}
+
+std::vector<AxisArray> CoreXYKinematics::linear_map() const {
+    std::vector<AxisArray> rows(3, AxisArray{});
+    rows[0][0] = 1, rows[0][1] = 1;   // X + Y
+    rows[1][0] = 1, rows[1][1] = -1;  // X - Y
+    rows[2][2] = 1;
+    return rows;
+}
+
 void CoreXYKinematics::inverse(const AxisArray& axes, std::span<double> joints) const noexcept {
     joints[0] = axes[0] + axes[1];
     joints[1] = axes[0] - axes[1];

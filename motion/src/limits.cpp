@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace motion {
 namespace {
@@ -31,26 +33,41 @@ bool is_arc(const Element& e) {
     return e.kind == ElementKind::Arc;
 }
 
-double speed_cap(const Element& e, const ElementBounds& b, const AxisLimits& lim, double feed,
-                 const LimitShares& share) {
-    auto jerk = [&] {  // asked only for arcs: it reads all nine axes
-        return std::any_of(lim.jerk_mm_s3.begin(), lim.jerk_mm_s3.end(),
-                           [](double j) { return j > 0; });
-    };
-    double blend = share.blend_centripetal > 0 ? share.blend_centripetal : kCentripetalShareBlend;
-    double centripetal = !is_arc(e) ? blend
-                         : jerk()   ? kCentripetalShareArc
-                                    : kCentripetalShareArcNoJerk;
-    double cubic = is_arc(e) ? kJerkCubicShareArc : kJerkCubicShareBlend;
-    // Smallest allowed v, v^2 and v^3 over the axes first, then one root of each.
-    double v1 = feed > 0 ? feed : kInf, v2 = kInf, v3 = kInf;
+// The limits of one set of rows: the axes, or the listed joints (slot j = joint j), each with
+// its derivative bounds (ElementBounds of the element, or joint_bounds()).
+struct Rows {
+    const ElementBounds& b;
+    const AxisArray& vel;
+    const AxisArray& acc;
+    const AxisArray& jerk;
+};
+
+// Smallest allowed v, v^2 and v^3 over the rows, into v1, v2, v3.
+void speed_terms(const Rows& r, double centripetal, double cubic, const LimitShares& share,
+                 double& v1, double& v2, double& v3) {
+    const ElementBounds& b = r.b;
     for (int i = 0; i < b.axis_count; ++i) {
         const int k = b.axes[i];
-        if (b.g1[k] > 0) v1 = std::min(v1, lim.vel_mm_s[k] / b.g1[k]);
-        if (b.g2[k] > 0) v2 = std::min(v2, centripetal * share.acc * lim.acc_mm_s2[k] / b.g2[k]);
-        if (b.g3[k] > 0 && lim.jerk_mm_s3[k] > 0)
-            v3 = std::min(v3, cubic * share.jerk * lim.jerk_mm_s3[k] / b.g3[k]);
+        if (b.g1[k] > 0) v1 = std::min(v1, r.vel[k] / b.g1[k]);
+        if (b.g2[k] > 0) v2 = std::min(v2, centripetal * share.acc * r.acc[k] / b.g2[k]);
+        if (b.g3[k] > 0 && r.jerk[k] > 0)
+            v3 = std::min(v3, cubic * share.jerk * r.jerk[k] / b.g3[k]);
     }
+}
+
+// joints: the joint rows, or null when the limits list none.
+double speed_cap(const Element& e, const Rows& axes, const Rows* joints, const AxisLimits& lim,
+                 double feed, const LimitShares& share) {
+    double blend = share.blend_centripetal > 0 ? share.blend_centripetal : kCentripetalShareBlend;
+    // jerk_limited() asked only for arcs: it reads all nine axes
+    double centripetal = !is_arc(e)          ? blend
+                         : jerk_limited(lim) ? kCentripetalShareArc
+                                             : kCentripetalShareArcNoJerk;
+    double cubic = is_arc(e) ? kJerkCubicShareArc : kJerkCubicShareBlend;
+    // Smallest allowed v, v^2 and v^3 over the axes (and joints) first, then one root of each.
+    double v1 = feed > 0 ? feed : kInf, v2 = kInf, v3 = kInf;
+    speed_terms(axes, centripetal, cubic, share, v1, v2, v3);
+    if (joints) speed_terms(*joints, centripetal, cubic, share, v1, v2, v3);
     double v = v1;
     if (v2 < v * v) v = std::sqrt(v2);
     if (v3 < v * v * v) v = std::cbrt(v3);
@@ -68,12 +85,12 @@ double arc_axis_acc(double t, double l, double n, double m) {
     return (m - n) * (m + n) / (m * l + std::sqrt(m * m * t * t - n * n * (t * t - l * l)));
 }
 
-double tangential_acc(const Element& e, const ElementBounds& b, const AxisLimits& lim, double v,
-                      const LimitShares& share) {
-    double a = kInf;
+double tangential_acc(const Element& e, const Rows& r, double v, const LimitShares& share,
+                      double a) {
+    const ElementBounds& b = r.b;
     for (int i = 0; i < b.axis_count; ++i) {
         const int k = b.axes[i];
-        double m = share.acc * lim.acc_mm_s2[k];
+        double m = share.acc * r.acc[k];
         double n = v * v * b.g2[k];
         if (is_arc(e)) {
             a = std::min(a, arc_axis_acc(b.tangential_in_plane[k], b.linear[k], n, m));
@@ -84,22 +101,67 @@ double tangential_acc(const Element& e, const ElementBounds& b, const AxisLimits
     return a;
 }
 
+// Lowers a for the cross term of the jerk and j for the rest, row by row.
+void jerk_terms(const Element& e, const Rows& r, double v, const LimitShares& share, double& a,
+                double& j) {
+    const ElementBounds& b = r.b;
+    for (int i = 0; i < b.axis_count; ++i) {
+        const int k = b.axes[i];
+        if (r.jerk[k] <= 0) continue;
+        double m = share.jerk * r.jerk[k];
+        double cross = is_arc(e) ? kJerkCrossShareArc : kJerkCrossShareBlend;
+        if (b.g2[k] > 0) a = std::min(a, cross * m / (3 * v * b.g2[k]));
+        if (b.g1[k] > 0) j = std::min(j, (m - 3 * v * a * b.g2[k] - v * v * v * b.g3[k]) / b.g1[k]);
+    }
+}
+
+// Smallest allowed rate r, r^2 and r^3 over the rows, into r1, r2, r3.
+void rate_terms(const Rows& r, double v, double a, double j, const LimitShares& share, double& r1,
+                double& r2, double& r3) {
+    const ElementBounds& b = r.b;
+    for (int i = 0; i < b.axis_count; ++i) {
+        const int k = b.axes[i];
+        if (b.g1[k] == 0 && b.g2[k] == 0) continue;
+        double vk = v * b.g1[k];
+        double ak = a * b.g1[k] + v * v * b.g2[k];
+        if (vk > 0) r1 = std::min(r1, r.vel[k] / vk);
+        if (ak > 0) r2 = std::min(r2, share.acc * r.acc[k] / ak);
+        if (r.jerk[k] > 0) {
+            double jk = j * b.g1[k] + 3 * v * a * b.g2[k] + v * v * v * b.g3[k];
+            if (jk > 0) r3 = std::min(r3, share.jerk * r.jerk[k] / jk);
+        }
+    }
+}
+
+Rows axis_rows(const ElementBounds& b, const AxisLimits& lim) {
+    return {b, lim.vel_mm_s, lim.acc_mm_s2, lim.jerk_mm_s3};
+}
+Rows joint_rows(const ElementBounds& jb, const JointLimits& joints) {
+    return {jb, joints.vel_mm_s, joints.acc_mm_s2, joints.jerk_mm_s3};
+}
+
+bool bad_limit(double x) {
+    return !(x >= 0) || !std::isfinite(x);
+}
+
 }  // namespace
 
 ElementLimits element_limits(const Element& e, const ElementBounds& b, const AxisLimits& lim,
                              double feed, const LimitShares& share) noexcept {
     ElementLimits out;
-    double v = speed_cap(e, b, lim, feed, share);
-    double a = tangential_acc(e, b, lim, v, share);
+    const Rows axes = axis_rows(b, lim);
+    // The joints' bounds are worked out only for a machine that lists joints.
+    ElementBounds jb;
+    const bool with_joints = lim.joints.count > 0;
+    if (with_joints) jb = joint_bounds(e, lim.joints);
+    const Rows joints = joint_rows(jb, lim.joints);
+    const Rows* joint_set = with_joints ? &joints : nullptr;
+    double v = speed_cap(e, axes, joint_set, lim, feed, share);
+    double a = tangential_acc(e, axes, v, share, kInf);
+    if (with_joints) a = tangential_acc(e, joints, v, share, a);
     double j = kInf;
-    for (int i = 0; i < b.axis_count; ++i) {
-        const int k = b.axes[i];
-        if (lim.jerk_mm_s3[k] <= 0) continue;
-        double m = share.jerk * lim.jerk_mm_s3[k];
-        double cross = is_arc(e) ? kJerkCrossShareArc : kJerkCrossShareBlend;
-        if (b.g2[k] > 0) a = std::min(a, cross * m / (3 * v * b.g2[k]));
-        if (b.g1[k] > 0) j = std::min(j, (m - 3 * v * a * b.g2[k] - v * v * v * b.g3[k]) / b.g1[k]);
-    }
+    jerk_terms(e, axes, v, share, a, j);
+    if (with_joints) jerk_terms(e, joints, v, share, a, j);
     out.vcap_mm_s = v;
     out.tangent.acc_mm_s2 = a;
     out.tangent.jerk_mm_s3 = std::isfinite(j) ? j : 0;
@@ -112,6 +174,11 @@ double parabola_cut_for_speed_mm(const AxisArray& dt_turn, double v_mm_s, const 
     double worst = 0;  // max_k |dT_k| / (allowed acceleration of k)
     for (int k = 0; k < kAxes; ++k)
         worst = std::max(worst, std::fabs(dt_turn[k]) / (blend * share.acc * lim.acc_mm_s2[k]));
+    // The parabola's second derivative is the constant dT / 2l: joint j sees (M dT)_j / 2l.
+    const JointLimits& jl = lim.joints;
+    for (int j = 0; j < jl.count; ++j)
+        worst = std::max(worst, std::fabs(joint_component(jl, j, dt_turn)) /
+                                    (blend * share.acc * jl.acc_mm_s2[j]));
     return v_mm_s * v_mm_s * worst / 2;
 }
 
@@ -120,22 +187,133 @@ double rate_cap(const ElementBounds& b, const AxisLimits& lim, double v, double 
     // r scales velocity by r, acceleration by r^2 and jerk by r^3: collect the smallest
     // allowed r, r^2 and r^3 first, then take one root of each.
     double r1 = max_rate, r2 = kInf, r3 = kInf;
-    for (int i = 0; i < b.axis_count; ++i) {
-        const int k = b.axes[i];
-        if (b.g1[k] == 0 && b.g2[k] == 0) continue;
-        double vk = v * b.g1[k];
-        double ak = a * b.g1[k] + v * v * b.g2[k];
-        if (vk > 0) r1 = std::min(r1, lim.vel_mm_s[k] / vk);
-        if (ak > 0) r2 = std::min(r2, share.acc * lim.acc_mm_s2[k] / ak);
-        if (lim.jerk_mm_s3[k] > 0) {
-            double jk = j * b.g1[k] + 3 * v * a * b.g2[k] + v * v * v * b.g3[k];
-            if (jk > 0) r3 = std::min(r3, share.jerk * lim.jerk_mm_s3[k] / jk);
-        }
+    rate_terms(axis_rows(b, lim), v, a, j, share, r1, r2, r3);
+    if (lim.joints.count > 0) {
+        const ElementBounds jb = joint_bounds(b, lim.joints);
+        rate_terms(joint_rows(jb, lim.joints), v, a, j, share, r1, r2, r3);
     }
     double r = r1;
     if (r2 < r * r) r = std::sqrt(r2);
     if (r3 < r * r * r) r = std::cbrt(r3);
     return std::max(r, 1.0);
+}
+
+double pass_speed_cap(const AxisArray& t1, const AxisArray& t2, const AxisLimits& lim,
+                      double cap_mm_s) noexcept {
+    for (int k = 0; k < kAxes; ++k) {
+        double t = std::max(std::fabs(t1[k]), std::fabs(t2[k]));
+        if (t > 0) cap_mm_s = std::min(cap_mm_s, lim.vel_mm_s[k] / t);
+    }
+    const JointLimits& jl = lim.joints;
+    for (int j = 0; j < jl.count; ++j) {
+        double t =
+            std::max(std::fabs(joint_component(jl, j, t1)), std::fabs(joint_component(jl, j, t2)));
+        if (t > 0) cap_mm_s = std::min(cap_mm_s, jl.vel_mm_s[j] / t);
+    }
+    return cap_mm_s;
+}
+
+bool jerk_limited(const AxisLimits& lim) noexcept {
+    auto any = [](const AxisArray& jerk, int n) {
+        return std::any_of(jerk.begin(), jerk.begin() + n, [](double j) { return j > 0; });
+    };
+    return any(lim.jerk_mm_s3, kAxes) || any(lim.joints.jerk_mm_s3, lim.joints.count);
+}
+
+ElementBounds joint_bounds(const Element& e, const JointLimits& joints) noexcept {
+    // Every element kind's bounds are functions of its vectors (origin, a, b, c, end) that stay
+    // linear under a linear map (a line's direction, an arc's in-plane frame and helix travel, a
+    // blend's tangents, a Bezier's control points): the mapped element's bounds are the joints'.
+    Element q = element_copy(e);
+    auto map = [&](const AxisArray& v, AxisArray& out) {
+        out.fill(0);
+        for (int j = 0; j < joints.count; ++j) out[j] = joint_component(joints, j, v);
+    };
+    map(e.origin, q.origin);
+    map(e.a, q.a);
+    map(e.b, q.b);
+    map(e.c, q.c);
+    map(e.end, q.end);
+    return bounds(q);
+}
+
+ElementBounds joint_bounds(const ElementBounds& b, const JointLimits& joints) noexcept {
+    ElementBounds out;
+    AxisArray* const outs[] = {&out.g1, &out.g2, &out.g3, &out.tangential_in_plane, &out.linear};
+    const AxisArray* const ins[] = {&b.g1, &b.g2, &b.g3, &b.tangential_in_plane, &b.linear};
+    for (int n = 0; n < 5; ++n) {
+        AxisArray& o = *outs[n];
+        const AxisArray& g = *ins[n];
+        o.fill(0);
+        for (int j = 0; j < joints.count; ++j) {
+            const AxisArray& m = joints.rows[static_cast<std::size_t>(j)];
+            for (int i = 0; i < b.axis_count; ++i) o[j] += std::fabs(m[b.axes[i]]) * g[b.axes[i]];
+        }
+    }
+    out.axis_count = 0;
+    for (int j = 0; j < joints.count; ++j)
+        if (out.g1[j] > 0 || out.g2[j] > 0 || out.g3[j] > 0)
+            out.axes[out.axis_count++] = static_cast<std::uint8_t>(j);
+    return out;
+}
+
+void validate_joints(const JointLimits& joints) {
+    if (joints.count < 0 || joints.count > kAxes)
+        throw std::invalid_argument("joint limits: " + std::to_string(joints.count) +
+                                    " joints listed, at most " + std::to_string(kAxes));
+    for (int j = 0; j < joints.count; ++j) {
+        const std::string name = "joint row " + std::to_string(j);
+        if (!(joints.vel_mm_s[j] > 0) || !(joints.acc_mm_s2[j] > 0) ||
+            !std::isfinite(joints.vel_mm_s[j]) || !std::isfinite(joints.acc_mm_s2[j]))
+            throw std::invalid_argument(name +
+                                        ": velocity and acceleration limits must be > 0 "
+                                        "and finite");
+        if (bad_limit(joints.jerk_mm_s3[j]))
+            throw std::invalid_argument(name + ": jerk limit must be >= 0 (0 = unlimited)");
+        for (double m : joints.rows[j])
+            if (!std::isfinite(m))
+                throw std::invalid_argument(name + ": the joint map is not finite");
+    }
+}
+
+void set_linear_joints(AxisLimits& lim, std::span<const AxisArray> rows,
+                       std::span<const JointLimit> joints) {
+    if (rows.size() != joints.size())
+        throw std::invalid_argument("joint limits: " + std::to_string(joints.size()) +
+                                    " joints' limits for a map of " + std::to_string(rows.size()));
+    if (rows.size() > static_cast<std::size_t>(kAxes))
+        throw std::invalid_argument("joint limits: more than " + std::to_string(kAxes) + " joints");
+    JointLimits out;
+    for (std::size_t j = 0; j < rows.size(); ++j) {
+        const JointLimit& own = joints[j];
+        if (bad_limit(own.vel_mm_s) || bad_limit(own.acc_mm_s2) || bad_limit(own.jerk_mm_s3))
+            throw std::invalid_argument("joint " + std::to_string(j) +
+                                        ": limits must be >= 0 and finite (0 = unlimited)");
+        // What the axes allow the joint anyway: sum_k |M_jk| limit_k (infinite jerk when an
+        // axis it follows has no jerk limit).
+        double vel = 0, acc = 0, jerk = 0;
+        for (int k = 0; k < kAxes; ++k) {
+            const double m = std::fabs(rows[j][k]);
+            if (m == 0) continue;
+            vel += m * lim.vel_mm_s[k];
+            acc += m * lim.acc_mm_s2[k];
+            jerk += lim.jerk_mm_s3[k] > 0 ? m * lim.jerk_mm_s3[k] : kInf;
+        }
+        if (vel == 0) continue;  // a joint no axis moves
+        const bool tighter = (own.vel_mm_s > 0 && own.vel_mm_s < vel) ||
+                             (own.acc_mm_s2 > 0 && own.acc_mm_s2 < acc) ||
+                             (own.jerk_mm_s3 > 0 && own.jerk_mm_s3 < jerk);
+        if (!tighter) continue;
+        const auto n = static_cast<std::size_t>(out.count++);
+        out.rows[n] = rows[j];
+        out.vel_mm_s[n] = own.vel_mm_s > 0 ? std::min(own.vel_mm_s, vel) : vel;
+        out.acc_mm_s2[n] = own.acc_mm_s2 > 0 ? std::min(own.acc_mm_s2, acc) : acc;
+        out.jerk_mm_s3[n] = own.jerk_mm_s3 > 0    ? std::min(own.jerk_mm_s3, jerk)
+                            : std::isfinite(jerk) ? jerk
+                                                  : 0;
+    }
+    validate_joints(out);
+    lim.joints = out;
 }
 
 }  // namespace motion

@@ -119,6 +119,7 @@ void validate(const PlannerConfig& cfg) {
             throw std::invalid_argument("axis " + std::to_string(k) +
                                         ": jerk limit must be >= 0 (0 = unlimited)");
     }
+    validate_joints(cfg.limits.joints);
     if (!(cfg.servo_period_s > 0)) throw std::invalid_argument("servo period must be > 0");
     for (double reserve : {cfg.override_reserve, cfg.override_reserve_no_jerk})
         if (!(reserve > 0 && cfg.junction_share >= 0 && reserve + cfg.junction_share < 1))
@@ -130,15 +131,12 @@ void validate(const PlannerConfig& cfg) {
 }
 
 double override_reserve_in_effect(const PlannerConfig& cfg) noexcept {
-    bool jerk = std::any_of(cfg.limits.jerk_mm_s3.begin(), cfg.limits.jerk_mm_s3.end(),
-                            [](double j) { return j > 0; });
-    return jerk ? cfg.override_reserve : cfg.override_reserve_no_jerk;
+    return jerk_limited(cfg.limits) ? cfg.override_reserve : cfg.override_reserve_no_jerk;
 }
 
 Planner::Planner(const PlannerConfig& cfg, const AxisArray& start) : cfg_(cfg), last_end_(start) {
     validate(cfg_);
-    jerk_mode_ = std::any_of(cfg_.limits.jerk_mm_s3.begin(), cfg_.limits.jerk_mm_s3.end(),
-                             [](double j) { return j > 0; });
+    jerk_mode_ = jerk_limited(cfg_.limits);
     reserve_ = override_reserve_in_effect(cfg_);
     items_.reserve(cfg_.window * 2);
     vj_.reserve(cfg_.window * 2 + 1);
@@ -220,12 +218,9 @@ void Planner::classify(const Piece& p, const Piece& next, Junction& jn) const {
     // with an arc turn a little harder, hence the margin.
     double l_speed_mm = kInf, speed_margin = 1;
     if (!jerk_mode_) {
-        double pass_mm_s = std::min(p.feed_mm_s > 0 ? p.feed_mm_s : kInf,
-                                    next.feed_mm_s > 0 ? next.feed_mm_s : kInf);
-        for (int k = 0; k < kAxes; ++k) {
-            double t = std::max(std::fabs(pe.tangent[k]), std::fabs(ns.tangent[k]));
-            if (t > 0) pass_mm_s = std::min(pass_mm_s, lim.vel_mm_s[k] / t);
-        }
+        double pass_mm_s = pass_speed_cap(pe.tangent, ns.tangent, lim,
+                                          std::min(p.feed_mm_s > 0 ? p.feed_mm_s : kInf,
+                                                   next.feed_mm_s > 0 ? next.feed_mm_s : kInf));
         speed_margin = p.feed_mm_s == next.feed_mm_s ? kCornerSpeedMargin : kMixedCornerSpeedMargin;
         l_speed_mm = parabola_cut_for_speed_mm(dt, speed_margin * pass_mm_s, lim,
                                                {1 - reserve_, 1 - reserve_});
@@ -267,19 +262,22 @@ void Planner::classify(const Piece& p, const Piece& next, Junction& jn) const {
     double near_mm = std::min(p.geom.length_mm, next.geom.length_mm) / 2;
     double travel_per_v = cfg_.max_rate * period;  // W / v
     double cap = kInf;
-    for (int k = 0; k < kAxes; ++k) {
-        double d = std::fabs(dt[k]);
-        if (d <= kTangentEps) continue;
-        double step = share * lim.acc_mm_s2[k] * period;
-        if (lim.jerk_mm_s3[k] > 0)
-            step = std::min(step, share * lim.jerk_mm_s3[k] * period * period);
+    // d: an axis's or joint's velocity step per unit of speed.
+    auto kink = [&](double d, double acc, double jerk) {
+        if (d <= kTangentEps) return;
+        double step = share * acc * period;
+        if (jerk > 0) step = std::min(step, share * jerk * period * period);
         double v = step / d;
         if (v * travel_per_v > near_mm) {  // 2 d v + 2 d (v travel_per_v / near) v = step
             double qa = 2 * d * travel_per_v / near_mm, qb = 2 * d;
             v = std::min(v, (-qb + std::sqrt(qb * qb + 4 * qa * step)) / (2 * qa));
         }
         cap = std::min(cap, v);
-    }
+    };
+    for (int k = 0; k < kAxes; ++k) kink(std::fabs(dt[k]), lim.acc_mm_s2[k], lim.jerk_mm_s3[k]);
+    for (int j = 0; j < lim.joints.count; ++j)
+        kink(std::fabs(joint_component(lim.joints, j, dt)), lim.joints.acc_mm_s2[j],
+             lim.joints.jerk_mm_s3[j]);
     // Kinks with an arc (rounding in the program, or a real corner): a blend where passing
     // the kink would cost speed.
     if (cap < feed && p.tolerance_mm > 0 && sin_angle < kMaxArcBlendSin) {
@@ -305,6 +303,16 @@ double Planner::curvature_step_cap(const AxisArray& d2_before, const AxisArray& 
         double step = std::fabs(d2_after[k] - d2_before[k]);
         if (step > 1e-12 && cfg_.limits.jerk_mm_s3[k] > 0)
             cap = std::min(cap, std::sqrt(cfg_.junction_share * cfg_.limits.jerk_mm_s3[k] *
+                                          cfg_.servo_period_s / step));
+    }
+    const JointLimits& jl = cfg_.limits.joints;
+    if (jl.count == 0 || !jerk_mode_) return cap;
+    AxisArray d2_step;
+    for (int k = 0; k < kAxes; ++k) d2_step[k] = d2_after[k] - d2_before[k];
+    for (int j = 0; j < jl.count; ++j) {
+        double step = std::fabs(joint_component(jl, j, d2_step));
+        if (step > 1e-12 && jl.jerk_mm_s3[j] > 0)
+            cap = std::min(cap, std::sqrt(cfg_.junction_share * jl.jerk_mm_s3[j] *
                                           cfg_.servo_period_s / step));
     }
     return cap;
@@ -413,6 +421,14 @@ OffsetFrame offset_frame(const AxisArray& t1, const AxisArray& t2, double cos_t,
         if (dt > 0) f.turn = std::min(f.turn, lim.acc_mm_s2[k] / dt);
         f.shift =
             std::max(f.shift, std::max(std::fabs(f.n1[k]), std::fabs(f.n2[k])) / lim.acc_mm_s2[k]);
+    }
+    const JointLimits& jl = lim.joints;
+    for (int j = 0; j < jl.count; ++j) {
+        double dt = std::fabs(joint_component(jl, j, t2) - joint_component(jl, j, t1));
+        if (dt > 0) f.turn = std::min(f.turn, jl.acc_mm_s2[j] / dt);
+        f.shift = std::max(f.shift, std::max(std::fabs(joint_component(jl, j, f.n1)),
+                                             std::fabs(joint_component(jl, j, f.n2))) /
+                                        jl.acc_mm_s2[j]);
     }
     return f;
 }

@@ -29,6 +29,12 @@ class Kinematics {
     virtual void inverse(const AxisArray& axes, std::span<double> joints) const noexcept = 0;
     // Axes the machine does not have are left as they are in `axes`.
     virtual void forward(std::span<const double> joints, AxisArray& axes) const noexcept = 0;
+    // For a kinematics whose joints are a constant linear map of the axes, q = M p (trivial,
+    // gantry, CoreXY): M's rows, one per joint, so that the planner can keep the joints within
+    // their limits (set_linear_joints(), limits.hpp). Empty for any other kinematics (a tilting
+    // table's joints depend on the angles): its joint velocities and accelerations are only
+    // checked as they are commanded, as in LinuxCNC. Configuration world.
+    virtual std::vector<AxisArray> linear_map() const { return {}; }
 };
 
 // Axis index of a letter (X=0 ... W=8), or -1.
@@ -43,6 +49,7 @@ class TrivialKinematics final : public Kinematics {
     std::span<const int> joint_axes() const noexcept override { return axes_; }
     void inverse(const AxisArray& axes, std::span<double> joints) const noexcept override;
     void forward(std::span<const double> joints, AxisArray& axes) const noexcept override;
+    std::vector<AxisArray> linear_map() const override;
 
   private:
     std::vector<int> axes_;
@@ -55,6 +62,7 @@ class CoreXYKinematics final : public Kinematics {
     std::span<const int> joint_axes() const noexcept override { return axes_; }
     void inverse(const AxisArray& axes, std::span<double> joints) const noexcept override;
     void forward(std::span<const double> joints, AxisArray& axes) const noexcept override;
+    std::vector<AxisArray> linear_map() const override;
 
   private:
     static constexpr int axes_[3] = {0, 1, 2};
@@ -150,7 +158,8 @@ class KinematicsSource {
 //     extern "C" const motion::KinematicsModule* cnc_kinematics_module();
 inline constexpr char kKinematicsEntryPoint[] = "cnc_kinematics_module";
 // 2: KinematicsSource gained copy_params_with_tool_offset (its vtable changed).
-inline constexpr std::uint32_t kKinematicsAbiVersion = 2;
+// 3: Kinematics gained linear_map (its vtable changed).
+inline constexpr std::uint32_t kKinematicsAbiVersion = 3;
 
 struct KinematicsModule {
     std::uint32_t abi_version;  // first, and kept first by every future version

@@ -8,13 +8,61 @@
 // With the per-axis bounds g1, g2, g3 of |p'|, |p''|, |p'''| (geometry.hpp) the element gets a
 // speed cap, a tangential acceleration and a tangential jerk such that every axis stays within
 // its share of the machine limits for every speed up to the cap.
+//
+// Joints of a linear kinematics (AxisLimits::joints, q = M p) are limited the same way: joint
+// j sees the curve q_j(s) = sum_k M_jk p_k(s), whose derivative bounds joint_bounds() gives, and
+// every function here takes the smaller of what the axes and what the joints allow.
 #pragma once
+
+#include <span>
 
 #include "motion/geometry.hpp"
 #include "motion/profile.hpp"
 #include "motion/types.hpp"
 
 namespace motion {
+
+// One joint's limits as a machine's settings give them; 0 = unlimited.
+struct JointLimit {
+    double vel_mm_s = 0;
+    double acc_mm_s2 = 0;
+    double jerk_mm_s3 = 0;
+};
+
+// Sets lim.joints from a linear kinematics' joint map (one row of M per joint, as
+// Kinematics::linear_map() gives it) and the joints' limits, after lim's axis limits are set.
+// Each joint keeps the smaller of its own limit and what the axes allow it anyway
+// (sum_k |M_jk| limit_k, the most it can see while every axis keeps its limit); a joint whose
+// own limits are all no tighter than that is left out, so the plans of a machine whose motors
+// are at least as fast as its axes do not change. Configuration world: throws
+// std::invalid_argument for a negative or non-finite limit, more than kAxes joints, or rows
+// and limits of different counts.
+void set_linear_joints(AxisLimits& lim, std::span<const AxisArray> rows,
+                       std::span<const JointLimit> joints);
+
+// Throws std::invalid_argument unless lim.joints is as set_linear_joints() leaves it (for
+// limits built by hand).
+void validate_joints(const JointLimits& joints);
+
+// Whether any axis or listed joint has a jerk limit: the planner's and the sampler's jerk mode.
+bool jerk_limited(const AxisLimits& lim) noexcept;
+
+// Joint j's part of a vector of axis values (a tangent, a change of tangent, a normal):
+// sum_k rows[j][k] v[k].
+inline double joint_component(const JointLimits& joints, int j, const AxisArray& v) noexcept {
+    const AxisArray& m = joints.rows[static_cast<std::size_t>(j)];
+    double x = 0;
+    for (int k = 0; k < kAxes; ++k) x += m[k] * v[k];
+    return x;
+}
+
+// The derivative bounds of element e as the listed joints see it, joint j in place of axis j:
+// the bounds of the element mapped through M, exact for every element kind (each kind's bounds
+// are functions of vectors that M maps linearly, e.g. a CoreXY 45 degree line: 2 for joint 0
+// (X + Y), 0 for joint 1 (X - Y) per unit of path). Realtime-safe.
+ElementBounds joint_bounds(const Element& e, const JointLimits& joints) noexcept;
+// The same from the axis bounds alone: sum_k |M_jk| g_k, never below the exact ones.
+ElementBounds joint_bounds(const ElementBounds& b, const JointLimits& joints) noexcept;
 
 // Fractions of the machine limits an element may use.
 struct LimitShares {
@@ -43,7 +91,15 @@ double parabola_cut_for_speed_mm(const AxisArray& dt_turn, double v_mm_s, const 
 // Largest factor (>= 1, <= max_rate) by which time may be sped up (feed override above 100 %)
 // on a stretch of this element where the path speed, |acceleration| and |jerk| peak at v, a, j,
 // keeping every axis within the shares of its limits.
+// Joints are bounded through the axis bounds (joint_bounds(b, ...)): never above their
+// limits, on a diagonal CoreXY line never below the cap either joint alone would give.
 double rate_cap(const ElementBounds& b, const AxisLimits& lim, double v, double a, double j,
                 const LimitShares& share, double max_rate) noexcept;
+
+// Highest speed at which a corner between the unit tangents t1 and t2 could be passed without
+// an axis or joint going faster than its velocity limit on either side: the smaller of cap and
+// every vel / max(|t1|, |t2|) (component-wise, joints through their rows).
+double pass_speed_cap(const AxisArray& t1, const AxisArray& t2, const AxisLimits& lim,
+                      double cap_mm_s) noexcept;
 
 }  // namespace motion

@@ -12,11 +12,27 @@ namespace motion {
 inline constexpr int kAxes = 9;  // X Y Z A B C U V W, in this order
 using AxisArray = std::array<double, kAxes>;
 
+// Limits of the joints (motors) of a linear kinematics, q = M p with M constant (trivial,
+// gantry, CoreXY), in joint units: the planner and the sampler keep joint j's velocity
+// |sum_k rows[j][k] p'_k ds/dt| and its acceleration and jerk within them as they keep each
+// axis within its own. Only the joints whose limits the axis limits do not already imply are
+// listed (set_linear_joints(), limits.hpp), so a machine whose motors are as fast as its axes
+// has count 0 and plans exactly as without joints. Velocity and acceleration are > 0 and
+// finite; a jerk of 0 means unlimited.
+struct JointLimits {
+    int count = 0;
+    std::array<AxisArray, kAxes> rows{};  // joint j = sum over k of rows[j][k] * axis k
+    AxisArray vel_mm_s{};
+    AxisArray acc_mm_s2{};
+    AxisArray jerk_mm_s3{};
+};
+
 // Per-axis machine limits. A jerk of 0 means "unlimited" for that axis (trapezoidal profiles).
 struct AxisLimits {
     AxisArray vel_mm_s{};
     AxisArray acc_mm_s2{};
     AxisArray jerk_mm_s3{};
+    JointLimits joints{};  // none by default: the axes' limits are the machine's
 };
 
 enum class SegmentKind : std::uint8_t { Line, Arc };
