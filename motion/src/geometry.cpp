@@ -138,14 +138,63 @@ AxisArray point_at(const Element& e, double s_mm) noexcept {
     return cp.p;
 }
 
-ElementBounds bounds(const Element& e) noexcept {
-    ElementBounds b;
+namespace {
+
+// A Bezier curve's derivatives are Bezier curves too and stay within the hull of their control
+// points: the factors of the hodographs' control points (1 / length per derivative).
+struct BezierFactors {
+    double s1, s2, s3;
+};
+
+BezierFactors bezier_factors(const Element& e) {
+    const double inv_l = 1 / e.length_mm;
+    const double s2 = 6 * inv_l * inv_l;
+    return {3 * inv_l, s2, s2 * inv_l};
+}
+
+// Inlined: as a call per axis it cost more than its work.
+[[gnu::always_inline]] inline void bezier_axis_bounds(const Element& e, int k,
+                                                      const BezierFactors& f, ElementBounds& b) {
+    double d0 = e.a[k] - e.origin[k], d1 = e.b[k] - e.a[k], d2 = e.end[k] - e.b[k];
+    // max(max(.)) is std::max({.}): the same comparisons in the same order.
+    b.g1[k] = b.linear[k] = f.s1 * std::max(std::max(std::fabs(d0), std::fabs(d1)), std::fabs(d2));
+    b.g2[k] = f.s2 * std::max(std::fabs(d1 - d0), std::fabs(d2 - d1));
+    b.g3[k] = f.s3 * std::fabs(d2 - 2 * d1 + d0);
+    b.tangential_in_plane[k] = 0;
+}
+
+// Lists, in the order given, the axes among `ax` whose bounds are not all 0. g1 is the sum
+// (arcs) or the value (others) of tangential_in_plane and linear, so g1, g2 and g3 cover all
+// five. The entry past the last listed axis is overwritten freely.
+template <class Axes>
+void list_moving_axes(ElementBounds& b, Axes ax) {
+    std::uint64_t bits[kAxes];
+    for (int j = 0; j < ax.count(); ++j) {
+        const int k = ax[j];
+        std::uint64_t x, y, z;
+        std::memcpy(&x, &b.g1[k], 8);
+        std::memcpy(&y, &b.g2[k], 8);
+        std::memcpy(&z, &b.g3[k], 8);
+        bits[j] = x | y | z;
+    }
+    int n = 0;
+    for (int j = 0; j < ax.count(); ++j) {
+        b.axes[n] = static_cast<std::uint8_t>(ax[j]);
+        n += bits[j] != 0;
+    }
+    b.axis_count = n;
+}
+
+// bounds(e) written into b (every member).
+void bounds_into(const Element& e, ElementBounds& b) {
     switch (e.kind) {
         case ElementKind::Line:
-            for (int k = 0; k < kAxes; ++k) {
-                b.g1[k] = b.linear[k] = std::fabs(e.a[k]);
-                b.g2[k] = b.g3[k] = b.tangential_in_plane[k] = 0;
-            }
+            // Whole arrays: a loop storing the zeros became one rep stos over all three, whose
+            // start-up cost more than the stores.
+            b.g2 = {};
+            b.g3 = {};
+            b.tangential_in_plane = {};
+            for (int k = 0; k < kAxes; ++k) b.g1[k] = b.linear[k] = std::fabs(e.a[k]);
             break;
         case ElementKind::Arc: {
             double k1 = std::fabs(e.sweep_rad / e.length_mm);
@@ -173,37 +222,38 @@ ElementBounds bounds(const Element& e) noexcept {
             break;
         }
         case ElementKind::Bezier: {
-            // A Bezier curve's derivatives are Bezier curves too and stay within the hull of
-            // their control points.
-            const double inv_l = 1 / e.length_mm;
-            const double s1 = 3 * inv_l, s2 = 6 * inv_l * inv_l, s3 = s2 * inv_l;
-            for (int k = 0; k < kAxes; ++k) {
-                double d0 = e.a[k] - e.origin[k], d1 = e.b[k] - e.a[k], d2 = e.end[k] - e.b[k];
-                b.g1[k] = b.linear[k] =
-                    s1 * std::max({std::fabs(d0), std::fabs(d1), std::fabs(d2)});
-                b.g2[k] = s2 * std::max(std::fabs(d1 - d0), std::fabs(d2 - d1));
-                b.g3[k] = s3 * std::fabs(d2 - 2 * d1 + d0);
-                b.tangential_in_plane[k] = 0;
-            }
+            const BezierFactors f = bezier_factors(e);
+            for (int k = 0; k < kAxes; ++k) bezier_axis_bounds(e, k, f, b);
             break;
         }
     }
-    // g1 is the sum (arcs) or the value (others) of tangential_in_plane and linear, so these
-    // three cover all five bounds. The entry past the last listed axis is overwritten freely.
-    std::uint64_t bits[kAxes];
-    for (int k = 0; k < kAxes; ++k) {
-        std::uint64_t x, y, z;
-        std::memcpy(&x, &b.g1[k], 8);
-        std::memcpy(&y, &b.g2[k], 8);
-        std::memcpy(&z, &b.g3[k], 8);
-        bits[k] = x | y | z;
+    list_moving_axes(b, AllAxes{});
+}
+
+}  // namespace
+
+ElementBounds bounds(const Element& e) noexcept {
+    ElementBounds b;
+    bounds_into(e, b);
+    return b;
+}
+
+ElementBounds bounds(const Element& e, std::span<const int> moving) noexcept {
+    ElementBounds b;  // one object on every path, built where the caller wants it
+    const BezierFactors f = bezier_factors(e);
+    if (e.kind != ElementKind::Bezier ||
+        !(std::isfinite(f.s1) && std::isfinite(f.s2) && std::isfinite(f.s3))) {
+        bounds_into(e, b);
+        return b;
     }
-    int n = 0;
-    for (int k = 0; k < kAxes; ++k) {
-        b.axes[n] = static_cast<std::uint8_t>(k);
-        n += bits[k] != 0;
-    }
-    b.axis_count = n;
+    // Whole arrays (vector stores; a loop would become rep stos, see the lines above).
+    b.g1 = {};
+    b.g2 = {};
+    b.g3 = {};
+    b.tangential_in_plane = {};
+    b.linear = {};
+    for (int k : moving) bezier_axis_bounds(e, k, f, b);
+    list_moving_axes(b, ListedAxes{moving.data(), static_cast<int>(moving.size())});
     return b;
 }
 

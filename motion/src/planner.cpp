@@ -385,6 +385,7 @@ bool Planner::bezier_corner(const Piece& p, const Piece& next, double sin_angle,
     const CurvePoint &a = fit.a, &b = fit.b;
     jn.set(kInf, false, l, Blend::Curve);
     make_corner_bezier(fit.ctrl, path, jn.curve);
+    jn.set_piece_axes(path);
     jn.curve_end_cap_mm_s = kInf;
     jn.curve_end_rough = false;
     if (!jerk_mode_) return true;  // without a jerk limit curvature steps cost nothing
@@ -536,6 +537,7 @@ bool Planner::offset_corner(const Piece& p, const Piece& next, double sin_angle,
     make_corner_bezier(out, path, jn.shift_out);
     make_corner_bezier(par, path, jn.curve);
     make_corner_bezier(in, path, jn.shift_back);
+    jn.set_piece_axes(path);
     return true;
 }
 
@@ -681,6 +683,7 @@ bool Planner::offset_arc_corner(const Piece& p, const Piece& next, double sin_an
         make_corner_bezier(out, path, jn.shift_out);
         make_corner_bezier(bend, path, jn.curve);
         make_corner_bezier(in, path, jn.shift_back);
+        jn.set_piece_axes(path);
         return true;
     }
     return false;
@@ -719,17 +722,18 @@ void Planner::close_piece(Piece& p, Piece* next) {
             // outputs switch where it starts): the move is left where the tool leaves its path.
             const Piece& shift_owner = p.geom.kind == ElementKind::Line ? p : *next;
             add_item(jn.shift_out, p.feed_mm_s, kInf, false, shift_owner, p.rapid,
-                     kShiftCentripetal);
-            add_item(jn.curve, feed, kInf, false, *next, rapid, kIsolatedBlendCentripetal);
+                     kShiftCentripetal, jn.moving_axes());
+            add_item(jn.curve, feed, kInf, false, *next, rapid, kIsolatedBlendCentripetal,
+                     jn.moving_axes());
             add_item(jn.shift_back, next->feed_mm_s, kInf, false, *next, next->rapid,
-                     kShiftCentripetal);
+                     kShiftCentripetal, jn.moving_axes());
             next->trim_start_mm = jn.cut_after_mm;
             next->rough_start = false;
             return;
         }
         case Blend::Curve:
             add_item(jn.curve, feed, jn.curve_end_cap_mm_s, jn.rough || jn.curve_end_rough, *next,
-                     rapid, turning);
+                     rapid, turning, jn.moving_axes());
             next->trim_start_mm = jn.blend_l_mm;
             next->rough_start = jn.curve_end_rough;
             return;
@@ -749,8 +753,9 @@ void Planner::close_piece(Piece& p, Piece* next) {
 }
 
 void Planner::add_item(const Element& e, double feed, double end_cap, bool rough,
-                       const Piece& owner, bool rapid, double blend_centripetal) {
-    Item& it = items_.emplace_back(e);
+                       const Piece& owner, bool rapid, double blend_centripetal,
+                       std::span<const int> moving) {
+    Item& it = items_.emplace_back(e, moving);
     double cut = reserve_ + (rough ? cfg_.junction_share : 0);
     it.lim = element_limits(e, it.bounds, cfg_.limits, feed, {1 - cut, 1 - cut, blend_centripetal});
     it.end_cap_mm_s = end_cap;

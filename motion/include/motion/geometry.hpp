@@ -24,6 +24,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <span>
 
 #include "motion/types.hpp"
 
@@ -97,6 +98,13 @@ struct ElementBounds {
     int axis_count;
 };
 ElementBounds bounds(const Element& e) noexcept;
+// bounds(e), the same values, for a Bezier whose four control points are equal, and finite, in
+// every axis but the `moving` ones (increasing), as make_corner_bezier()'s are in the still axes
+// of a path at rest (CornerPath::still_at_rest): each bound there is a finite factor times the
+// magnitude of a difference of equal numbers, +0, so only the moving axes are computed. Any
+// other element, and a Bezier whose factors (powers of 1 / length) are not finite, get
+// bounds(e). For the planner, whose corner pieces move in 2 or 3 of the 9 axes.
+ElementBounds bounds(const Element& e, std::span<const int> moving) noexcept;
 
 Element make_line(const AxisArray& start, const AxisArray& end) noexcept;
 // Throws PlanError for a zero radius, an end off the circle, a bad plane or zero turns.

@@ -23,6 +23,7 @@
 // segment changes nothing.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -105,7 +106,10 @@ class Planner {
     struct Item {
         // Built in place in items_ from its element: value-initialising it first would clear
         // all of it only for add_item() to overwrite it; bounds() writes straight into it.
-        explicit Item(const Element& e) : geom(element_copy(e)), bounds(motion::bounds(e)) {}
+        // moving: the only axes e moves in, if known (bounds(e, moving)).
+        Item(const Element& e, std::span<const int> moving)
+            : geom(element_copy(e)),
+              bounds(moving.empty() ? motion::bounds(e) : motion::bounds(e, moving)) {}
         Element geom;
         ElementBounds bounds;  // bounds(geom), kept for the rate caps when it is emitted
         ElementLimits lim;
@@ -138,9 +142,24 @@ class Planner {
         // lines), shift back; the first move loses blend_l_mm, the second cut_after_mm.
         Element shift_out, shift_back;
         double cut_after_mm = 0;
+        // Curve and Offset: the only axes their pieces move in (the first piece_axis_count),
+        // when they were built on a corner path at rest (make_corner_bezier: every control point
+        // equals the corner's in the others), else none; see bounds(e, moving).
+        std::array<int, kAxes> piece_axes;
+        int piece_axis_count = 0;
 
         void set(double cap, bool is_rough, double l_mm, Blend kind = Blend::None) {
             cap_mm_s = cap, rough = is_rough, blend_l_mm = l_mm, blend = kind;
+            piece_axis_count = 0;
+        }
+        // After set(): the pieces were built by make_corner_bezier() on `path`.
+        void set_piece_axes(const CornerPath& path) {
+            if (!path.still_at_rest) return;
+            std::copy_n(path.axes.begin(), path.dims, piece_axes.begin());
+            piece_axis_count = path.dims;
+        }
+        std::span<const int> moving_axes() const {
+            return {piece_axes.data(), static_cast<std::size_t>(piece_axis_count)};
         }
     };
 
@@ -163,8 +182,9 @@ class Planner {
     double curvature_step_cap(const AxisArray& d2_before, const AxisArray& d2_after) const;
     void close_piece(Piece& p, Piece* next);
     // blend_centripetal: LimitShares::blend_centripetal for a corner blend (0 = default).
+    // moving: as for Item.
     void add_item(const Element& e, double feed, double end_cap, bool rough, const Piece& owner,
-                  bool rapid, double blend_centripetal = 0);
+                  bool rapid, double blend_centripetal = 0, std::span<const int> moving = {});
     std::size_t plan_and_emit(bool all);  // returns how many records it emitted
     bool can_join(const Group& g, const Item& it) const;
     void build_groups();
