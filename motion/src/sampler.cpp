@@ -26,6 +26,11 @@ constexpr std::size_t kWarmRecordsPerPeriod = 8;
 // by this much planned time either side: the planned clock the sampler follows is summed in a
 // different order than the checks sum it (rounding errors of 1e-16 s).
 constexpr double kWalkPadS = 1e-9;
+// A slowing move takes r' to this share of the acceleration room of its period: at the room
+// itself the backup's first piece, whose check pairs the rate at the piece's end with r' at
+// its start, could never pass, and the period after would brake instead (a two-period chatter
+// of the acceleration).
+constexpr double kRampShare = 0.97;
 
 bool is_action(const PreparedSegment& rec) noexcept {
     return rec.action.kind != ActionKind::None;
@@ -414,6 +419,18 @@ void rate_path(RateState s, double target, double dt, const RateLimits& lim,
     if (left > 0) out.add({0, left, false, -1});
 }
 
+// r' towards -vm at r'' = -am (back towards it at +am when beyond), then held, for dt: a
+// slowing move that leaves the landing to its backup.
+void ramp_path(RateState s, double vm, double am, double dt, RatePath& out) noexcept {
+    double left = dt;
+    if (s.rd != -vm) {
+        const double h = std::min(left, std::fabs(s.rd + vm) / am);
+        out.add({s.rd > -vm ? -am : am, h, false, -1});
+        left -= h;
+    }
+    if (left > 0) out.add({0, left, false, -1});
+}
+
 // The backup after a move: r' braked to 0 at |r''| = am, then, above 1, r brought down to 1
 // (|r'| <= vm, |r''| <= am) and held. False when the brake would take r below 0.
 bool brake_path(RateState s, const RateLimits& lim, RatePath& out) noexcept {
@@ -474,33 +491,97 @@ double Sampler::advance_rate_jerk(double target, double dt) noexcept {
     double vm_acc = 0;
     const RateLimits room = jerk_room_limits(target, dt, &vm_acc);
     if (target < r_ && target < 1 && r_ <= kPlannedRate) {
-        // Slowing: r'' against the plan's jerk has the room that jerk leaves on its other
-        // side, and the backup brakes r' where the falling rate has made room (coast_backup()).
+        // Slowing (a hold, an abort, an override down), in the order tried:
+        // - ramp: r'' < 0 with the room the plan's jerk leaves on that side (signed_jerk_room():
+        //   nearly 2 J against the plan's jerk), r' down to the acceleration room of this
+        //   period at the rate now (vm_acc, over the whole stretch ahead, assumes the rate may
+        //   fall to 0 there, where a r^2 no longer helps);
+        // - where r'' < 0 has no room (the plan's terms alone pull the tangential jerk to -J,
+        //   or nearly): the least r'' that keeps it there, often 0 (coasting);
+        // each taken only while the backup from its end (coast_backup()) still lands at or
+        // above the target and the whole passes the check;
+        // - else land now along a fresh backup (its first period).
+        // So the rate falls as fast as the jerk and the acceleration allow and the landing
+        // comes as late as the room allows, as in the shortest stop. The room for r'' < 0
+        // over this period falls as r' grows more negative in it (the 3 a r r' term), nearly
+        // linearly in |r''|: the room f0 at r' as it is, f1 at the cap, and the crossing
+        // |r''| = f(|r''|) of the line through them, taken once more.
         const double pad = r_ * dt + kWalkPadS;
-        RateSpan box{std::max(0.0, r_ + std::min(rd_, 0.0) * dt), r_, rd_, rd_, 0};
-        WalkFrom at0;
-        const double am0 = signed_jerk_room(tau_, tau_ + pad, box, at0).down;
-        box.rd_lo = rd_ - am0 * dt;
-        box.r_lo = std::max(0.0, r_ + box.rd_lo * dt);
-        WalkFrom at1;
-        const double am1 = std::min(am0, signed_jerk_room(tau_, tau_ + pad, box, at1).down);
-        if (am1 > room.max_rate_per_s2) {
-            const RateLimits lim{vm_acc, am1};
-            RatePath move;
-            rate_path({r_, rd_}, target, dt, lim, move);
+        double rd_room = 0, brake_min = 0;
+        auto room_down = [&](double am) {
+            const RateSpan box{std::max(0.0, r_ + (std::min(rd_, 0.0) - am * dt) * dt), r_,
+                               rd_ - am * dt, rd_, 0};
+            WalkFrom at;
+            const SignedRoom sr = signed_jerk_room(tau_, tau_ + pad, box, at);
+            rd_room = sr.rd_down;
+            brake_min = sr.up_min;
+            return sr.down;
+        };
+        const double f0 = room_down(0);
+        const double least_brake = brake_min;
+        const double am_cap = std::min(f0, cfg_.max_rate / (kRateRampS * kRateRampS));
+        double am1 = 0;
+        if (am_cap > room.max_rate_per_s2) {
+            const double f1 = room_down(am_cap);
+            const double slope = std::max(0.0, (f0 - f1) / am_cap);
+            const double guess = std::min(am_cap, f0 / (1 + slope));
+            am1 = guess < am_cap ? std::min(guess, room_down(guess)) : am_cap;
+        }
+        const double vm_move = std::clamp(rd_room, vm_acc, cfg_.max_rate / kRateRampS);
+        auto try_move = [&](const RatePath& move, double am_hint) {
             RateState end{r_, rd_};
             double tau_end = tau_;
             for (int i = 0; i < move.count; ++i)
                 tau_end += step_rate(end, move.pieces[static_cast<std::size_t>(i)]);
             RatePath backup;
-            if (coast_backup(end.r, end.rd, tau_end, am1, backup)) {
-                RatePath whole = move;
-                for (int i = 0; i < backup.count; ++i)
-                    whole.add(backup.pieces[static_cast<std::size_t>(i)]);
-                if (whole.count < RatePath::kMaxPieces && rate_path_safe(whole)) {
-                    cert_ = backup;
-                    last_limits_ = lim;
-                    return apply_rate(move);
+            double r_end = 0;
+            if (!coast_backup(end.r, end.rd, tau_end, am_hint, backup, r_end) ||
+                r_end < target - 1e-9)
+                return false;
+            RatePath whole = move;
+            for (int i = 0; i < backup.count; ++i)
+                whole.add(backup.pieces[static_cast<std::size_t>(i)]);
+            if (whole.count >= RatePath::kMaxPieces || !rate_path_safe(whole)) return false;
+            cert_ = backup;
+            last_limits_ = {vm_move, std::max(am_hint, room.max_rate_per_s2)};
+            return true;
+        };
+        if (am1 > room.max_rate_per_s2) {
+            RatePath move;
+            ramp_path({r_, rd_}, kRampShare * vm_move, am1, dt, move);
+            if (try_move(move, am1)) return apply_rate(move);
+        } else if (rd_ < 0) {
+            RatePath move;
+            const double u = least_brake * (1 + 1e-6);
+            const double h = u > 0 ? std::min(dt, -rd_ / u) : dt;
+            move.add({u, h, h < dt, -1});
+            if (h < dt) move.add({0, dt - h, false, -1});
+            if (try_move(move, std::max(u, room.max_rate_per_s2))) return apply_rate(move);
+        }
+        if (rd_ < 0) {
+            // The same pieces after a coast that lowers r by as much as they would land above
+            // the target land on it, which a hold needs to end (r = 0).
+            RatePath landing;
+            double r_end = 0;
+            const double hint = std::max(am1, room.max_rate_per_s2);
+            if (coast_backup(r_, rd_, tau_, hint, landing, r_end)) {
+                RatePath shifted;
+                if (r_end > target && r_end <= kPlannedRate) {
+                    shifted.add({0, (r_end - target) / -rd_, false, -1});
+                    for (int i = 0; i < landing.count; ++i)
+                        shifted.add(landing.pieces[static_cast<std::size_t>(i)]);
+                    RatePiece& last = shifted.pieces[static_cast<std::size_t>(shifted.count - 1)];
+                    if (last.zero_rd) last.r_snap = target;
+                }
+                for (RatePath* path : {&shifted, &landing}) {
+                    if (path->count == 0 || path->count == RatePath::kMaxPieces ||
+                        !rate_path_safe(*path))
+                        continue;
+                    RatePath head;
+                    split_path(*path, dt, head);
+                    cert_ = *path;
+                    last_limits_ = {vm_move, hint};
+                    return apply_rate(head);
                 }
             }
         }
@@ -713,10 +794,11 @@ bool Sampler::rate_path_safe(const RatePath& path) noexcept {
     return s.rd == 0 && s.r <= kPlannedRate;
 }
 
-// Per axis (the terms added, valid on any element): |j_t| g1 + 3 u |a_t| g2 + u^3 g3 <= J, so
-// j_t = j r^3 + 3 a r r' + v r'' may range over +-m with m = (J - 3 u |a_t| g2 - u^3 g3) / g1.
-// With the plan's terms j r^3 + 3 a r r' as a signed range [lo, hi], r'' > 0 has (m - hi) / v
-// and r'' < 0 has (m + lo) / v: against the plan's jerk nearly 2 J, with it what is left.
+// Per axis the tangential jerk j_t = j r^3 + 3 a r r' + v r'' may range over [lo, hi] (on a
+// line +-(J - 3 u |a_t| g2 - u^3 g3) / g1, the terms added; on a planar arc the across term in
+// quadrature). With the plan's terms j r^3 + 3 a r r' as a signed range [p_lo, p_hi], r'' > 0
+// has (hi - p_hi) / v and r'' < 0 has (p_lo - lo) / v: against the plan's jerk nearly 2 J,
+// with it what is left.
 Sampler::SignedRoom Sampler::signed_jerk_room(double from, double to, const RateSpan& box,
                                               WalkFrom& at) noexcept {
     const AxisLimits& lim = cfg_.limits;
@@ -724,46 +806,71 @@ Sampler::SignedRoom Sampler::signed_jerk_room(double from, double to, const Rate
     const double r_hi = std::max(box.r_hi, 0.0);
     RateSpan no_rdd = box;
     no_rdd.rdd = 0;
-    double up = kInf, down = kInf, up_min = 0, down_min = 0;
+    double up = kInf, down = kInf, up_min = 0, down_min = 0, rd_down = kInf;
+    const Span r_span{std::max(box.r_lo, 0.0), r_hi};
+    const Span r2_span = r_span * r_span;
     auto visit = [&](const PreparedSegment& rec, const ElementBounds& b, const ProfilePhase& ph,
                      double t_lo, double t_hi, double) {
         const PlanSpan pl = plan_span(ph, t_lo, t_hi);
         const double v_hi = pl.v.abs_max(), v_lo = std::max(pl.v.lo, 0.0);
         if (v_hi <= 1e-12) return true;  // nothing moves: any r'' fits
         const double free_j = 1 - (rec.rough ? js * r_hi * r_hi : 0);
+        const double free_a = 1 - (rec.rough ? js * r_hi : 0);
         const PathLoad load = path_load(pl, no_rdd);
         const double u = load.u.abs_max(), a_t = load.at.abs_max();
+        const double plan_at_lo = (pl.a * r2_span).lo;
+        const double u_lo = std::max(load.u.lo, 0.0);
         for (int q = 0; q < b.axis_count; ++q) {
             const int k = b.axes[q];
-            if (lim.jerk_mm_s3[k] <= 0 || b.g1[k] <= 1e-12) continue;
-            const double m =
-                (free_j * lim.jerk_mm_s3[k] - 3 * u * a_t * b.g2[k] - u * u * u * b.g3[k]) /
-                b.g1[k];
-            up = std::min(up, (m - load.jt.hi) / v_hi);
-            down = std::min(down, (m + load.jt.lo) / v_hi);
+            if (b.g1[k] <= 1e-12) continue;
+            const double ma = free_a * lim.acc_mm_s2[k], mj = free_j * lim.jerk_mm_s3[k];
+            const double tip = b.tangential_in_plane[k];
+            const bool planar_arc = tip > 0 && b.linear[k] == 0;
+            // The tangential acceleration a r^2 + v r' the axis allows beside u^2 p'', and the
+            // range [lo, hi] of the tangential jerk beside 3 u a_t p'' and u^3 p''': on a planar
+            // arc p' and p'' are perpendicular and p''' antiparallel to p' (ranged_axis_peak()),
+            // elsewhere the terms add.
+            double m_a = 0, lo = 0, hi = 0;
+            if (planar_arc) {
+                const double across = u * u * b.g2[k];
+                m_a = ma > across ? std::sqrt(ma * ma - across * across) / tip : -1.0;
+                const double y = 3 * u * a_t * b.g2[k];
+                const double room = mj > y ? std::sqrt(mj * mj - y * y) : -kInf;
+                lo = (u * u * u * b.g3[k] - room) / tip;
+                hi = (u_lo * u_lo * u_lo * b.g3[k] + room) / tip;
+            } else {
+                m_a = (ma - u * u * b.g2[k]) / b.g1[k];
+                hi = (mj - 3 * u * a_t * b.g2[k] - u * u * u * b.g3[k]) / b.g1[k];
+                lo = -hi;
+            }
+            rd_down = std::min(rd_down, (m_a + plan_at_lo) / v_hi);  // r' < 0: a_t >= -m_a
+            if (lim.jerk_mm_s3[k] <= 0) continue;
+            up = std::min(up, (hi - load.jt.hi) / v_hi);
+            down = std::min(down, (load.jt.lo - lo) / v_hi);
             // Where the plan's terms alone pass one side, r'' must pull them back by at least
             // the excess, at the lowest speed.
-            if (load.jt.lo < -m)
-                up_min = std::max(up_min, v_lo > 0 ? (-m - load.jt.lo) / v_lo : kInf);
-            if (load.jt.hi > m)
-                down_min = std::max(down_min, v_lo > 0 ? (load.jt.hi - m) / v_lo : kInf);
+            if (load.jt.lo < lo)
+                up_min = std::max(up_min, v_lo > 0 ? (lo - load.jt.lo) / v_lo : kInf);
+            if (load.jt.hi > hi)
+                down_min = std::max(down_min, v_lo > 0 ? (load.jt.hi - hi) / v_lo : kInf);
         }
         return true;
     };
     if (walk_phases(from, to, at, visit) == Walk::Unknown) {
-        const double beyond = unknown_room(r_hi).max_rate_per_s2;
-        up = std::min(up, beyond);
-        down = std::min(down, beyond);
+        const RateLimits beyond = unknown_room(r_hi);
+        up = std::min(up, beyond.max_rate_per_s2);
+        down = std::min(down, beyond.max_rate_per_s2);
+        rd_down = std::min(rd_down, beyond.max_rate_per_s);
     }
-    return {std::max(up, 0.0), std::max(down, 0.0), up_min, down_min};
+    return {up, down, up_min, down_min, rd_down};
 }
 
 // Each piece halves r' (the last lands it on 0) at the room of the stretch it covers, guessed
 // from the previous piece's |r''| (am_hint for the first) and taken again over the range that
 // gives; with no room to brake while the rate falls, a piece coasts until r has fallen by a
 // quarter (the plan's j r^3 shrinks with it).
-bool Sampler::coast_backup(double r, double rd, double tau, double am_hint,
-                           RatePath& out) noexcept {
+bool Sampler::coast_backup(double r, double rd, double tau, double am_hint, RatePath& out,
+                           double& r_end) noexcept {
     constexpr int kMaxBrakePieces = 12;
     const double floor = rl_.max_rate_per_s2;
     const double cap = cfg_.max_rate / (kRateRampS * kRateRampS);
@@ -791,14 +898,15 @@ bool Sampler::coast_backup(double r, double rd, double tau, double am_hint,
         // A room reaching the guess covers the piece it was taken over (a larger |r''| only
         // shortens it); a smaller one is the next guess; a stretch that needs more than it
         // allows (the plan's jerk turns round inside it) is cut shorter.
-        double frac = mag <= am * 2e-3 || n >= kMaxBrakePieces - 1 ? 1.0 : 0.5;
+        double frac = mag <= am * 2e-3 || n >= kMaxBrakePieces - 1 ? 1.0 : n == 1 ? 0.25 : 0.5;
         double guess = am, h = 0, pick = -1;
         Span got{};
         for (int it = 0; it < 6 && pick < 0; ++it) {
             got = room_at(guess, frac, h);
             if (got.hi < floor) break;
-            if (got.lo > got.hi) {
+            if (got.lo > got.hi) {  // a shorter piece: less of r', at least twice as fast
                 frac /= 2;
+                guess = std::max(2 * guess, got.hi);
             } else if (got.hi >= guess) {
                 pick = got.hi;
             } else {
@@ -806,9 +914,10 @@ bool Sampler::coast_backup(double r, double rd, double tau, double am_hint,
             }
         }
         if (pick < 0) {
-            // No room to brake r': coast while the rate falls, which makes room.
-            if (got.hi >= floor || got.lo > 0 || rd > 0 || r <= 0) return false;
-            const RatePiece pc{0, 0.25 * r / mag, false, -1};
+            // No room to brake r' found (or too little to finish within the pieces): coast
+            // while the rate falls by a tenth, which makes room (j r^3 shrinks).
+            if (got.lo > 0 || rd > 0 || r <= 0) return false;
+            const RatePiece pc{0, 0.1 * r / mag, false, -1};
             RateState s{r, rd};
             tau += step_rate(s, pc);
             r = s.r;
@@ -826,6 +935,7 @@ bool Sampler::coast_backup(double r, double rd, double tau, double am_hint,
         out.add(pc);
         if (out.count >= RatePath::kMaxPieces - 3) return false;
     }
+    r_end = r;
     if (r < -1e-12) return false;
     const double over = r - 1;
     if (over <= 0) return true;

@@ -677,6 +677,65 @@ TEST(SamplerJerk, HoldInsideAJerkPhaseRespondsAtOnce) {
     }
 }
 
+// The bound docs/motion-planner.md argues for a hold on a straight line with the program
+// queued, at r = 1: the path's deceleration starts (its jerk below -J / 2, or its acceleration
+// falling by J dt / 4 in a period) within 3 periods or 3 ms, whichever is longer, and the stop
+// takes at most 3 kRateRampS + 10 periods longer than the shortest jerk-limited stop from the
+// state the hold found (shortest_stop_s(), which no hold can beat). kRateRampS (5 ms,
+// sampler.cpp) caps |r'| and |r''| where the plan barely moves; the periods are the decisions
+// taken at period boundaries (response, landing, the last period at a small rate). Over
+// A 300 ... 3000 mm/s^2, J 3000 ... 300 000 mm/s^3 and periods of 0.25 ... 2 ms, 751 holds
+// every 1/25 of the acceleration from rest and in cruise: the largest excess is 27 ms (a 2 ms
+// period, bound 35 ms). The old sampler took up to 0.87 s more and failed 824 of the checks.
+TEST(SamplerJerk, HoldsEndWithinTheShortestStopPlusABound) {
+    constexpr double kRateRampS = 0.005;
+    int holds = 0;
+    double worst = 0;
+    for (double dt : {0.25e-3, 1e-3, 2e-3})
+        for (double acc : {300.0, 1000.0, 3000.0})
+            for (double jerk : {3e3, 3e4, 3e5}) {
+                PlannerConfig cfg = uniform(100, acc, jerk);
+                cfg.servo_period_s = dt;
+                const double accel_s = 100 / acc + acc / jerk;
+                const long periods = long(accel_s / dt) + 20;
+                for (long at = 1; at <= periods; at += std::max(1L, periods / 25)) {
+                    SpscRing<PreparedSegment> ring(64);
+                    Sampler sampler(sampler_config(cfg), ring, AxisArray{});
+                    load(ring, cfg, {feed_to(400, 100, 0)});
+                    LimitCheck check(cfg.limits);
+                    MotionSample m{};
+                    for (long n = 0; n < at; ++n) check(m = sampler.advance(dt), dt);
+                    const double u0 = m.vel_mm_s[0], a0 = m.acc_mm_s2[0];
+                    if (!(u0 > 0)) continue;
+                    const double shortest = shortest_stop_s(u0, a0, acc, jerk);
+                    sampler.set_hold(true);
+                    long n = 0, turned = -1;
+                    double acc_before = a0;
+                    while (!sampler.status().held && n < 200000) {
+                        check(m = sampler.advance(dt), dt);
+                        ++n;
+                        if (turned < 0 && (m.jerk_mm_s3[0] < -jerk / 2 ||
+                                           m.acc_mm_s2[0] < acc_before - jerk * dt / 4))
+                            turned = n;
+                        acc_before = m.acc_mm_s2[0];
+                    }
+                    const std::string where = "dt " + std::to_string(dt) + " A " +
+                                              std::to_string(acc) + " J " +
+                                              std::to_string(jerk) + " at " + std::to_string(at);
+                    ASSERT_EQ(check.first(), "") << where;
+                    ASSERT_TRUE(sampler.status().held) << where;
+                    EXPECT_GE(turned, 1) << where;
+                    EXPECT_LE(turned * dt, std::max(3 * dt, 3e-3) + 1e-12) << where;
+                    EXPECT_GE(n * dt, shortest - 1e-9) << where;
+                    EXPECT_LE(n * dt, shortest + 3 * kRateRampS + 10 * dt) << where;
+                    worst = std::max(worst, n * dt - shortest);
+                    ++holds;
+                }
+            }
+    EXPECT_GT(holds, 500);
+    std::printf("%d holds, largest excess over the shortest stop %.4f s\n", holds, worst);
+}
+
 // The ranged bound of the jerk-limited checks against the motion it bounds, sampled: random
 // lines, arcs and helices in the three planes, random phases of the plan (any sign of v, a, j),
 // random parts of them and random rate boxes. At every sample (17 points along the element, 9

@@ -19,19 +19,22 @@
 //   limits over the part of every profile phase it covers (rate_path_safe(): per piece, the
 //   smaller of two bounds on a r^2 + v r' and j r^3 + 3 a r r' + v r'': the plan's peaks
 //   with the terms added, and the terms as signed ranges with an arc's perpendicular parts in
-//   quadrature, ranged_axis_peak()). While slowing below 1 a move whose r'' opposes the plan's
-//   jerk is tried first (signed_jerk_room(): inside a jerk phase at r = 1 that side has nearly
-//   2 J, the other 1 %), with a backup that brakes r' in pieces, each at the room of the
-//   stretch it covers, coasting while there is none as the falling rate makes room
-//   (coast_backup()). Otherwise the period follows the backup accepted before
-//   (cert_), which stays valid because it was checked to its end. A rate held at r <= 1 is a
-//   pure time scale, which the plan keeps within (1 - reserve) of every limit, so the backup
-//   always ends safe; beyond the records in the ring only what the planner guarantees of every
-//   record is trusted (unknown_safe(): the fixed bounds at r = 1, more as r falls). The rate
-//   then changes quickly where the plan leaves room (cruise, r < 1, slowing while the plan
-//   speeds up or against its jerk); where the plan's own jerk already points the way the rate
-//   change needs (slowing in a jerk phase that ends an acceleration), it rides that jerk until
-//   the phase leaves room, which is what the axis's jerk limit allows anyway.
+//   quadrature, ranged_axis_peak()). While slowing below 1 other moves are tried first, each
+//   with a backup that brakes r' in pieces, each at the room of the stretch it covers,
+//   coasting while there is none as the falling rate makes room (coast_backup()): r'' against
+//   the plan's jerk (signed_jerk_room(): inside a jerk phase at r = 1 that side has nearly
+//   2 J, the other 1 %), or the least r'' that keeps the tangential jerk at -J, as long as
+//   that backup still lands at or above the target; else that landing itself. So a hold
+//   follows nearly the shortest jerk-limited stop. Otherwise the period follows the backup
+//   accepted before (cert_), which stays valid because it was checked to its end. A rate held
+//   at r <= 1 is a pure time scale, which the plan keeps within (1 - reserve) of every limit,
+//   so the backup always ends safe; beyond the records in the ring only what the planner
+//   guarantees of every record is trusted (unknown_safe(): the fixed bounds at r = 1, more as r
+//   falls; rate_fits_any_record()). The rate then changes quickly where the plan leaves room
+//   (cruise, r < 1, slowing while the plan speeds up or against its jerk); slowing in a jerk
+//   phase that ends an acceleration, the plan's own jerk already decelerates at the limit and
+//   the rate rides it (what the axis's jerk limit allows anyway); speeding up inside a jerk
+//   phase at r near 1 still waits for room (only slowing has the moves above).
 // Above r = 1 the per-phase rate caps of the records within reach shape the target, and the
 // checks above keep a r^2, j r^3 and v r within the limits. So any override in [0, max_rate],
 // any hold and any abort keeps every axis within its limits.
@@ -200,18 +203,20 @@ class Sampler {
     // The largest |r''| of each sign that keeps the tangential jerk j r^3 + 3 a r r' + v r''
     // within every axis's jerk limit over planned time [from, to] with r, r' within `box` (the
     // plan's signed terms, so an r'' against the plan's jerk gets the room that jerk leaves on
-    // its other side); 0 where none fits. A guess for the jerk-limited proposals and backups:
-    // rate_path_safe() decides.
+    // its other side); negative where none fits. A guess for the jerk-limited proposals and
+    // backups: rate_path_safe() decides.
     struct SignedRoom {
         double up = 0, down = 0;          // largest |r''| for r'' > 0 and for r'' < 0
         double up_min = 0, down_min = 0;  // least |r''| of that sign (0: r'' = 0 fits)
+        double rd_down = 0;  // largest |r'| for r' < 0 that keeps the acceleration within A
     };
     SignedRoom signed_jerk_room(double from, double to, const RateSpan& box, WalkFrom& at) noexcept;
     // The backup that brakes r' to 0 in pieces, each at the largest |r''| its own stretch
     // allows (signed_jerk_room()), coasting (r'' = 0) while there is none and the rate falls;
     // then, above 1, brings the rate down to 1. False when it cannot end within
-    // RatePath::kMaxPieces pieces with r >= 0.
-    bool coast_backup(double r, double rd, double tau, double am_hint, RatePath& out) noexcept;
+    // RatePath::kMaxPieces pieces with r >= 0; r_end: the rate where r' reaches 0.
+    bool coast_backup(double r, double rd, double tau, double am_hint, RatePath& out,
+                      double& r_end) noexcept;
     // The phases of the ring's records over planned time [from, to] (front record's time) are
     // fine with the rate, its r' and r'' within `box` (sampler.cpp).
     bool stretch_safe(double from, double to, const RateSpan& box, WalkFrom& at) noexcept;
