@@ -415,13 +415,20 @@ struct OffsetFrame {
 OffsetFrame offset_frame(const AxisArray& t1, const AxisArray& t2, double cos_t, double sin_t,
                          const AxisLimits& lim) {
     OffsetFrame f;
+    // The axes' divisions first, with no branch, so that they are done two at a time (four
+    // per axis, most of the frame's cost); then the smallest and largest, in axis order. A
+    // turn of 0 in an axis gives acc / 0 = inf (acc > 0, validate()), which leaves the smallest
+    // as it is, as a NaN does.
+    AxisArray turn, shift;
     for (int k = 0; k < kAxes; ++k) {
         f.n1[k] = -(t2[k] - cos_t * t1[k]) / sin_t;
         f.n2[k] = (t1[k] - cos_t * t2[k]) / sin_t;
-        double dt = std::fabs(t2[k] - t1[k]);
-        if (dt > 0) f.turn = std::min(f.turn, lim.acc_mm_s2[k] / dt);
-        f.shift =
-            std::max(f.shift, std::max(std::fabs(f.n1[k]), std::fabs(f.n2[k])) / lim.acc_mm_s2[k]);
+        turn[k] = lim.acc_mm_s2[k] / std::fabs(t2[k] - t1[k]);
+        shift[k] = std::max(std::fabs(f.n1[k]), std::fabs(f.n2[k])) / lim.acc_mm_s2[k];
+    }
+    for (int k = 0; k < kAxes; ++k) {
+        f.turn = std::min(f.turn, turn[k]);
+        f.shift = std::max(f.shift, shift[k]);
     }
     const JointLimits& jl = lim.joints;
     for (int j = 0; j < jl.count; ++j) {
