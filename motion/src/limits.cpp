@@ -220,6 +220,14 @@ bool jerk_limited(const AxisLimits& lim) noexcept {
     return any(lim.jerk_mm_s3, kAxes) || any(lim.joints.jerk_mm_s3, lim.joints.count);
 }
 
+AxisLimits joint_space_limits(const JointLimits& joints) noexcept {
+    AxisLimits out;
+    out.vel_mm_s = joints.vel_mm_s;
+    out.acc_mm_s2 = joints.acc_mm_s2;
+    out.jerk_mm_s3 = joints.jerk_mm_s3;
+    return out;
+}
+
 ElementBounds joint_bounds(const Element& e, const JointLimits& joints) noexcept {
     // Every element kind's bounds are functions of its vectors (origin, a, b, c, end) that stay
     // linear under a linear map (a line's direction, an arc's in-plane frame and helix travel, a

@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "motion/jerk_stop.hpp"
+#include "motion/limits.hpp"
 
 namespace motion {
 namespace {
@@ -220,14 +221,13 @@ RateLimits rate_limits(const SamplerConfig& cfg) noexcept {
     // of the acceleration.
     double eta = cfg.override_reserve;
     double vm = kInf, am = kInf;
-    const AxisLimits& lim = cfg.limits;
-    for (int k = 0; k < kAxes; ++k) {
-        vm = std::min(vm, eta * lim.acc_mm_s2[k] / lim.vel_mm_s[k]);
-        if (lim.jerk_mm_s3[k] > 0) {
-            vm = std::min(vm, eta / 2 * lim.jerk_mm_s3[k] / (3 * cfg.max_rate * lim.acc_mm_s2[k]));
-            am = std::min(am, eta / 2 * lim.jerk_mm_s3[k] / lim.vel_mm_s[k]);
+    for_each_limit(cfg.limits, [&](double vel, double acc, double jerk) {
+        vm = std::min(vm, eta * acc / vel);
+        if (jerk > 0) {
+            vm = std::min(vm, eta / 2 * jerk / (3 * cfg.max_rate * acc));
+            am = std::min(am, eta / 2 * jerk / vel);
         }
-    }
+    });
     // Without a jerk limit r'' is free; a 5 ms ramp of r' keeps the rate smooth anyway.
     if (!std::isfinite(am)) am = vm / kRateRampS;
     return {vm, am};
@@ -235,13 +235,13 @@ RateLimits rate_limits(const SamplerConfig& cfg) noexcept {
 
 Sampler::Sampler(const SamplerConfig& cfg, SpscRing<PreparedSegment>& ring, const AxisArray& start)
     : cfg_(cfg),
+      joint_space_(joint_space_limits(cfg.limits.joints)),
       rl_(rate_limits(cfg)),
       last_limits_(rl_),
       ring_(ring),
       rooms_(std::max<std::size_t>(cfg.lookahead_records, 1)) {
     last_.pos_mm = start;
-    jerk_limited_ = std::any_of(cfg.limits.jerk_mm_s3.begin(), cfg.limits.jerk_mm_s3.end(),
-                                [](double j) { return j > 0; });
+    jerk_limited_ = jerk_limited(cfg.limits);
 }
 
 // The front record's outputs fall due once: when the path first moves in it, or when it is
@@ -621,13 +621,15 @@ double Sampler::apply_rate(const RatePath& path) noexcept {
     return std::max(passed, 0.0);
 }
 
-// Calls visit(rec, bounds, phase, t_lo, t_hi, duration) for every phase of the ring's motion
-// records that overlaps planned time [from, to] (the front record's time), with [t_lo, t_hi] the
-// part of the phase (in its own time) that the stretch covers, widened by kWalkPadS for the
+// Calls visit(rec, bounds, limits, phase, t_lo, t_hi, duration) for every phase of the ring's
+// motion records that overlaps planned time [from, to] (the front record's time), with [t_lo, t_hi]
+// the part of the phase (in its own time) that the stretch covers, widened by kWalkPadS for the
 // rounding of the planned clock, in order, until visit returns false (Walk::Stopped).
 // Walk::Unknown: the ring (or the look-ahead) ends before `to`. `at` carries where the walk may
 // start between calls with rising `from` (the records wholly before it are skipped for good). The
-// records' bounds come from the cache (cached()).
+// records' bounds come from the cache (cached()). With a linear kinematics' joints listed in the
+// limits, each phase is visited once more with the joints' bounds and limits, joint j in place
+// of axis j.
 template <class Visit>
 Sampler::Walk Sampler::walk_phases(double from, double to, WalkFrom& at, Visit&& visit) noexcept {
     const std::size_t n = std::min(ring_.size(), cfg_.lookahead_records);
@@ -639,7 +641,7 @@ Sampler::Walk Sampler::walk_phases(double from, double to, WalkFrom& at, Visit&&
             at.index = i + 1;
             at.start_s = start + p.duration_s;
         } else if (start + p.duration_s >= from && !is_action(rec)) {
-            const ElementBounds& b = cached(i).bounds;
+            const RecordCache& c = cached(i);
             for (int ph = 0; ph < p.count; ++ph) {
                 const double t0 = p.phases[ph].t0_s;
                 const double t1 = ph + 1 < p.count ? p.phases[ph + 1].t0_s : p.duration_s;
@@ -647,7 +649,12 @@ Sampler::Walk Sampler::walk_phases(double from, double to, WalkFrom& at, Visit&&
                 const double len = std::max(0.0, t1 - t0);
                 const double lo = std::clamp(from - (start + t0) - kWalkPadS, 0.0, len);
                 const double hi = std::clamp(to - (start + t0) + kWalkPadS, lo, len);
-                if (!visit(rec, b, p.phases[ph], lo, hi, len)) return Walk::Stopped;
+                if (!visit(rec, c.bounds, cfg_.limits, p.phases[ph], lo, hi, len))
+                    return Walk::Stopped;
+                // A linear kinematics' joints, each like an axis (limits.hpp, joint_bounds()).
+                if (cfg_.limits.joints.count > 0 &&
+                    !visit(rec, c.joint_bounds, joint_space_, p.phases[ph], lo, hi, len))
+                    return Walk::Stopped;
             }
         }
         start += p.duration_s;
@@ -683,11 +690,10 @@ RateLimits Sampler::jerk_room_limits(double target, double dt, double* vm_acc_ou
     const double r_lo = slowing ? 0.0 : std::max(0.0, r_ - down * down / (2 * am0));
     const Span r_span{r_lo, r_hi};
     const Span r2_span = r_span * r_span;
-    const AxisLimits& lim = cfg_.limits;
     const double js = cfg_.junction_share;
     double vm = kInf, am = kInf, vm_acc_all = kInf;
-    auto visit = [&](const PreparedSegment& rec, const ElementBounds& b, const ProfilePhase& ph,
-                     double t_lo, double t_hi, double dur) {
+    auto visit = [&](const PreparedSegment& rec, const ElementBounds& b, const AxisLimits& lim,
+                     const ProfilePhase& ph, double t_lo, double t_hi, double dur) {
         const double keep = 1 - cfg_.override_reserve - (rec.rough ? js : 0);
         const double free_a = 1 - (rec.rough ? js * r_hi : 0);
         const double free_j = 1 - (rec.rough ? js * r_hi * r_hi : 0);
@@ -801,7 +807,6 @@ bool Sampler::rate_path_safe(const RatePath& path) noexcept {
 // with it what is left.
 Sampler::SignedRoom Sampler::signed_jerk_room(double from, double to, const RateSpan& box,
                                               WalkFrom& at) noexcept {
-    const AxisLimits& lim = cfg_.limits;
     const double js = cfg_.junction_share;
     const double r_hi = std::max(box.r_hi, 0.0);
     RateSpan no_rdd = box;
@@ -809,8 +814,8 @@ Sampler::SignedRoom Sampler::signed_jerk_room(double from, double to, const Rate
     double up = kInf, down = kInf, up_min = 0, down_min = 0, rd_down = kInf;
     const Span r_span{std::max(box.r_lo, 0.0), r_hi};
     const Span r2_span = r_span * r_span;
-    auto visit = [&](const PreparedSegment& rec, const ElementBounds& b, const ProfilePhase& ph,
-                     double t_lo, double t_hi, double) {
+    auto visit = [&](const PreparedSegment& rec, const ElementBounds& b, const AxisLimits& lim,
+                     const ProfilePhase& ph, double t_lo, double t_hi, double) {
         const PlanSpan pl = plan_span(ph, t_lo, t_hi);
         const double v_hi = pl.v.abs_max(), v_lo = std::max(pl.v.lo, 0.0);
         if (v_hi <= 1e-12) return true;  // nothing moves: any r'' fits
@@ -955,13 +960,12 @@ bool Sampler::coast_backup(double r, double rd, double tau, double am_hint, Rate
 // Next to a rough junction the step there (junction share, times r for a velocity step, r^2
 // for a curvature step) is kept out too.
 bool Sampler::stretch_safe(double from, double to, const RateSpan& box, WalkFrom& at) noexcept {
-    const AxisLimits& lim = cfg_.limits;
     const double js = cfg_.junction_share;
     const double r_hi = box.r_hi, rdd_max = std::fabs(box.rdd);
     const double rd_max = std::max(std::fabs(box.rd_lo), std::fabs(box.rd_hi));
     const double r2 = r_hi * r_hi, r3 = r2 * r_hi;
-    auto visit = [&](const PreparedSegment& rec, const ElementBounds& b, const ProfilePhase& ph,
-                     double t_lo, double t_hi, double dur) {
+    auto visit = [&](const PreparedSegment& rec, const ElementBounds& b, const AxisLimits& lim,
+                     const ProfilePhase& ph, double t_lo, double t_hi, double dur) {
         const double keep = 1 - cfg_.override_reserve - (rec.rough ? js : 0);
         const double free_a = 1 - (rec.rough ? js * r_hi : 0);
         const double free_j = 1 - (rec.rough ? js * r2 : 0);
@@ -1025,13 +1029,12 @@ bool rate_fits_any_record(const SamplerConfig& cfg, const RateLimits& fixed,
     const double js = cfg.junction_share;
     const double acc_left = 1 - keep * r * r - js * r * (1 - r);
     const double jerk_left = 1 - keep * r * r * r - js * r * r * (1 - r);
-    const AxisLimits& lim = cfg.limits;
-    for (int k = 0; k < kAxes; ++k) {
-        const double v = lim.vel_mm_s[k], a = lim.acc_mm_s2[k], j = lim.jerk_mm_s3[k];
-        if (v * rd > a * acc_left) return false;
-        if (j > 0 && 3 * r * keep * a * rd + v * rdd > j * jerk_left) return false;
-    }
-    return true;
+    bool fits = true;
+    for_each_limit(cfg.limits, [&](double v, double a, double j) {
+        if (v * rd > a * acc_left) fits = false;
+        if (j > 0 && 3 * r * keep * a * rd + v * rdd > j * jerk_left) fits = false;
+    });
+    return fits;
 }
 
 bool Sampler::unknown_safe(const RateSpan& box) const noexcept {
@@ -1045,15 +1048,13 @@ RateLimits Sampler::unknown_room(double r_hi) const noexcept {
     const double js = cfg_.junction_share;
     const double acc_left = 1 - keep * r * r - js * r * (1 - r);
     const double jerk_left = 1 - keep * r * r * r - js * r * r * (1 - r);
-    const AxisLimits& lim = cfg_.limits;
     double vm = kInf, am = kInf;
-    for (int k = 0; k < kAxes; ++k) {
-        const double v = lim.vel_mm_s[k], a = lim.acc_mm_s2[k], j = lim.jerk_mm_s3[k];
+    for_each_limit(cfg_.limits, [&](double v, double a, double j) {
         if (v > 0) vm = std::min(vm, a * acc_left / v);
-        if (j <= 0) continue;
+        if (j <= 0) return;
         if (r * a > 0) vm = std::min(vm, j * jerk_left / (2 * 3 * r * keep * a));
         if (v > 0) am = std::min(am, j * jerk_left / (2 * v));
-    }
+    });
     return {std::max(vm, rl_.max_rate_per_s), std::max(am, rl_.max_rate_per_s2)};
 }
 
@@ -1068,15 +1069,19 @@ RateLimits Sampler::rate_limits_now(double target, double dt) const noexcept {
     MotionSample now = sample(ring_.peek(0), tau_);
     double horizon = dt + last_limits_.max_rate_per_s / last_limits_.max_rate_per_s2;
     double vm = kInf;
-    for (int k = 0; k < kAxes; ++k) {
-        double vk = std::fabs(now.vel_mm_s[k]) + lim.acc_mm_s2[k] * r_ * horizon;
-        if (vk <= 0) continue;
+    // vel_now: an axis's or joint's |velocity| now.
+    auto row = [&](double vel_now, double acc) {
+        double vk = vel_now + acc * r_ * horizon;
+        if (vk <= 0) return;
         // Next to an unblended kink the plan uses keep - junction_share and the kink's velocity
         // step (junction_share of a period's acceleration) scales with r, not r^2.
         const double js = cfg_.junction_share;
         const double used = std::max(keep * r_ * r_, (keep - js) * r_ * r_ + js * r_);
-        vm = std::min(vm, lim.acc_mm_s2[k] * (1 - used) / vk);
-    }
+        vm = std::min(vm, acc * (1 - used) / vk);
+    };
+    for (int k = 0; k < kAxes; ++k) row(std::fabs(now.vel_mm_s[k]), lim.acc_mm_s2[k]);
+    for (int j = 0; j < lim.joints.count; ++j)
+        row(std::fabs(joint_component(lim.joints, j, now.vel_mm_s)), lim.joints.acc_mm_s2[j]);
     if (!std::isfinite(vm)) return rl_;
     vm = std::max(vm, rl_.max_rate_per_s);
     return {vm, vm / kRateRampS};
@@ -1087,9 +1092,8 @@ RateLimits Sampler::rate_limits_now(double target, double dt) const noexcept {
 // a_peak g1_k + v_peak^2 g2_k and v_peak g1_k. An unblended kink steps the velocity by up to
 // junction_share of a period's acceleration (the planner's budget for it), scaled by the rate:
 // that share is kept out of the room. Infinite where nothing moves.
-double Sampler::phase_room(const ElementBounds& b, const ProfilePhase& ph, double t_s,
-                           double r_hi) const noexcept {
-    const AxisLimits& lim = cfg_.limits;
+double Sampler::phase_room(const ElementBounds& b, const AxisLimits& lim, const ProfilePhase& ph,
+                           double t_s, double r_hi) const noexcept {
     const double usable = 1 - cfg_.junction_share * r_hi;
     const PhasePeaks pk = phase_peaks(ph, t_s);
     double best = kInf;
@@ -1114,11 +1118,16 @@ double Sampler::room_rate(double from, double to, double r_hi) const noexcept {
         const Profile1D& p = rec.profile;
         if (start + p.duration_s >= from && !is_action(rec)) {
             const ElementBounds b = bounds(rec.geom);
+            const JointLimits& jl = cfg_.limits.joints;
+            const ElementBounds jb = jl.count > 0 ? joint_bounds(rec.geom, jl) : ElementBounds{};
             for (int ph = 0; ph < p.count; ++ph) {
                 const double t0 = p.phases[ph].t0_s;
                 const double t1 = ph + 1 < p.count ? p.phases[ph + 1].t0_s : p.duration_s;
                 if (start + t1 < from || start + t0 > to) continue;
-                best = std::min(best, phase_room(b, p.phases[ph], t1 - t0, r_hi));
+                best = std::min(best, phase_room(b, cfg_.limits, p.phases[ph], t1 - t0, r_hi));
+                if (jl.count > 0)
+                    best =
+                        std::min(best, phase_room(jb, joint_space_, p.phases[ph], t1 - t0, r_hi));
                 if (best == 0) return 0;
             }
         }
@@ -1184,10 +1193,16 @@ const Sampler::RecordCache& Sampler::cached(std::size_t i) noexcept {
         const Profile1D& p = rec.profile;
         e.bounds = bounds(rec.geom);
         const ElementBounds& b = e.bounds;
+        const JointLimits& jl = cfg_.limits.joints;
+        if (jl.count > 0) e.joint_bounds = joint_bounds(rec.geom, jl);
         for (int ph = 0; ph < p.count && !jerk_limited_; ++ph) {
             const double t0 = p.phases[ph].t0_s;
             const double t1 = ph + 1 < p.count ? p.phases[ph + 1].t0_s : p.duration_s;
-            e.room_per_s[ph] = phase_room(b, p.phases[ph], t1 - t0, cfg_.max_rate);
+            e.room_per_s[ph] = phase_room(b, cfg_.limits, p.phases[ph], t1 - t0, cfg_.max_rate);
+            if (jl.count > 0)
+                e.room_per_s[ph] = std::min(
+                    e.room_per_s[ph],
+                    phase_room(e.joint_bounds, joint_space_, p.phases[ph], t1 - t0, cfg_.max_rate));
         }
     }
     return rooms_[(rooms_head_ + i) % size];
@@ -1289,12 +1304,17 @@ void Sampler::consume_finished_records() noexcept {
 double Sampler::decel_limit(const PreparedSegment& rec, double u) const noexcept {
     const ElementBounds b = bounds(rec.geom);
     double a = kInf, floor = kInf;
-    for (int k = 0; k < kAxes; ++k) {
-        if (b.g1[k] <= 1e-12) continue;
-        const double acc = cfg_.limits.acc_mm_s2[k];
-        a = std::min(a, (acc - u * u * b.g2[k]) / b.g1[k]);
-        floor = std::min(floor, 0.05 * acc / b.g1[k]);
-    }
+    auto rows = [&](const ElementBounds& bb, const AxisLimits& lim) {
+        for (int k = 0; k < kAxes; ++k) {
+            if (bb.g1[k] <= 1e-12) continue;
+            const double acc = lim.acc_mm_s2[k];
+            a = std::min(a, (acc - u * u * bb.g2[k]) / bb.g1[k]);
+            floor = std::min(floor, 0.05 * acc / bb.g1[k]);
+        }
+    };
+    rows(b, cfg_.limits);
+    if (cfg_.limits.joints.count > 0)
+        rows(joint_bounds(rec.geom, cfg_.limits.joints), joint_space_);
     if (!std::isfinite(floor)) return kInf;  // nothing moves on this record
     return std::max(a, floor);
 }
@@ -1351,9 +1371,14 @@ double Sampler::path_accel(const PathState& ps) const noexcept {
 double Sampler::path_jerk_limit(const PreparedSegment& rec) const noexcept {
     const ElementBounds b = bounds(rec.geom);
     double j = kInf;
-    for (int k = 0; k < kAxes; ++k)
-        if (b.g1[k] > 1e-12 && cfg_.limits.jerk_mm_s3[k] > 0)
-            j = std::min(j, cfg_.limits.jerk_mm_s3[k] / b.g1[k]);
+    auto rows = [&](const ElementBounds& bb, const AxisLimits& lim) {
+        for (int k = 0; k < kAxes; ++k)
+            if (bb.g1[k] > 1e-12 && lim.jerk_mm_s3[k] > 0)
+                j = std::min(j, lim.jerk_mm_s3[k] / bb.g1[k]);
+    };
+    rows(b, cfg_.limits);
+    if (cfg_.limits.joints.count > 0)
+        rows(joint_bounds(rec.geom, cfg_.limits.joints), joint_space_);
     return j;
 }
 

@@ -11,6 +11,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "motion/kinematics.hpp"
@@ -118,6 +119,47 @@ TEST_P(CoreXYPrograms, ArcCornersKeepTheMotorsWithinTheirLimits) {
     const Program prog = random_program(rng, opt);
     const PlannerConfig cfg = corexy_config(rng, seed % 2 == 0);
     expect_within_joint_limits(cfg, prog, play(cfg, prog, nullptr, {}), seed, true);
+}
+
+// Overrides from 0 to 120 % changing every 50-500 ms, then a hold and its release: the sampler's
+// rate changes keep the motors within their limits too (jerk limited on even seeds).
+TEST_P(CoreXYPrograms, OverridesAndAHoldKeepTheMotorsWithinTheirLimits) {
+    const std::uint64_t seed = GetParam() + 1500;
+    std::mt19937_64 rng(seed);
+    const Program prog = random_program(rng, {20, false});
+    const PlannerConfig cfg = corexy_config(rng, seed % 2 == 0);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::vector<std::pair<long, double>> plan;
+    long t = 0;
+    for (int i = 0; i < 12; ++i) {
+        t += 50 + long(u(rng) * 450);
+        const double r = u(rng);
+        plan.emplace_back(t, r < 0.15 ? 0.0 : r < 0.4 ? 1.2 : 0.05 + 1.15 * u(rng));
+    }
+    const long hold_at = t + 100 + long(u(rng) * 1000), release_at = hold_at + 300;
+    auto script = [&](long n, Sampler& s) {
+        for (const auto& [at, value] : plan)
+            if (at == n) s.set_feed_override(value);
+        if (n == plan.back().first + 1) s.set_feed_override(1.0);
+        if (n == hold_at) s.set_hold(true);
+        if (n == release_at) s.set_hold(false);
+    };
+    expect_within_joint_limits(cfg, prog, play(cfg, prog, script, {}), seed, true);
+}
+
+// An abort at a random moment stops within the motors' limits (jerk limited on odd seeds).
+TEST_P(CoreXYPrograms, AbortKeepsTheMotorsWithinTheirLimits) {
+    const std::uint64_t seed = GetParam() + 2000;
+    std::mt19937_64 rng(seed);
+    const Program prog = random_program(rng, {20, false});
+    const PlannerConfig cfg = corexy_config(rng, seed % 2 == 1);
+    std::uniform_real_distribution<double> u(0, 1);
+    const long abort_at = 50 + long(u(rng) * 2000);
+    auto script = [&](long n, Sampler& s) {
+        if (n == abort_at) s.abort();
+    };
+    const PlayReport rep = play(cfg, prog, script, {});
+    expect_within_joint_limits(cfg, prog, rep, seed, !rep.aborted);
 }
 
 INSTANTIATE_TEST_SUITE_P(Seeds, CoreXYPrograms, ::testing::Range<std::uint64_t>(1, 41));

@@ -56,6 +56,19 @@ inline double joint_component(const JointLimits& joints, int j, const AxisArray&
     return x;
 }
 
+// Calls f(vel, acc, jerk) with the limits of every axis, then of every listed joint: for bounds
+// that hold whatever the plan does (each axis and joint within its share of its limits).
+template <class F>
+void for_each_limit(const AxisLimits& lim, F&& f) {
+    for (int k = 0; k < kAxes; ++k) f(lim.vel_mm_s[k], lim.acc_mm_s2[k], lim.jerk_mm_s3[k]);
+    const JointLimits& jl = lim.joints;
+    for (int j = 0; j < jl.count; ++j) f(jl.vel_mm_s[j], jl.acc_mm_s2[j], jl.jerk_mm_s3[j]);
+}
+
+// The listed joints' limits as an AxisLimits whose axis j is joint j (slots past the count and
+// its own joints empty), for code written per axis that runs once more over joint_bounds().
+AxisLimits joint_space_limits(const JointLimits& joints) noexcept;
+
 // The derivative bounds of element e as the listed joints see it, joint j in place of axis j:
 // the bounds of the element mapped through M, exact for every element kind (each kind's bounds
 // are functions of vectors that M maps linearly, e.g. a CoreXY 45 degree line: 2 for joint 0

@@ -191,8 +191,9 @@ class Sampler {
     double current_override() const noexcept;
     double rate_cap_ahead() const noexcept;
     double rate_cap_free(double dt) noexcept;
-    double phase_room(const ElementBounds& b, const ProfilePhase& ph, double t_s,
-                      double r_hi) const noexcept;
+    // lim: the axes' limits for the element's bounds, joint_space_ for joint_bounds().
+    double phase_room(const ElementBounds& b, const AxisLimits& lim, const ProfilePhase& ph,
+                      double t_s, double r_hi) const noexcept;
     struct WalkFrom {
         std::size_t index = 0;  // first ring record the walk may need
         double start_s = 0;     // its start in the front record's planned time
@@ -244,6 +245,7 @@ class Sampler {
     struct RecordCache {
         const PreparedSegment* rec = nullptr;  // the ring slot it was computed for (a guard)
         ElementBounds bounds{};
+        ElementBounds joint_bounds{};  // the listed joints' (limits.hpp), when there are any
         std::array<double, kMaxPhases> room_per_s{};
     };
     const RecordCache& cached(std::size_t i) noexcept;
@@ -265,6 +267,9 @@ class Sampler {
     void enter_front() noexcept;
 
     SamplerConfig cfg_;
+    // The listed joints' limits, joint j as axis j (limits.hpp): the checks written per axis run
+    // once more over the joints' bounds with these.
+    AxisLimits joint_space_;
     RateLimits rl_;           // fixed limits from the reserve
     RateLimits last_limits_;  // limits used in the last period
     RatePath cert_;           // jerk limited: the checked backup from the current (tau, r, r')
