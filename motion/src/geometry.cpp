@@ -185,8 +185,9 @@ void list_moving_axes(ElementBounds& b, Axes ax) {
     b.axis_count = n;
 }
 
-// bounds(e) written into b (every member).
-void bounds_into(const Element& e, ElementBounds& b) {
+// bounds(e) written into b (every member). Inlined: bounds(e) is called for every line the
+// planner adds, where a call more costs as much as the zeros of the line case.
+[[gnu::always_inline]] inline void bounds_into(const Element& e, ElementBounds& b) {
     switch (e.kind) {
         case ElementKind::Line:
             // Whole arrays: a loop storing the zeros became one rep stos over all three, whose
