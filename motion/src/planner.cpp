@@ -139,6 +139,10 @@ Planner::Planner(const PlannerConfig& cfg, const AxisArray& start) : cfg_(cfg), 
     jerk_mode_ = jerk_limited(cfg_.limits);
     reserve_ = override_reserve_in_effect(cfg_);
     items_.reserve(cfg_.window * 2);
+    // At most one group per item (without a jerk limit exactly one): reserved like the items,
+    // so that build_groups() does not reallocate them within a window (it grew them by
+    // doubling from none, copying them each time, in every new planner).
+    groups_.reserve(cfg_.window * 2);
     vj_.reserve(cfg_.window * 2 + 1);
     out_.reserve(cfg_.window * 2);
 }
