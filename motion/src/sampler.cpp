@@ -521,11 +521,21 @@ double Sampler::advance_rate_jerk(double target, double dt) noexcept {
         const double least_brake = brake_min;
         const double am_cap = std::min(f0, cfg_.max_rate / (kRateRampS * kRateRampS));
         double am1 = 0;
-        if (am_cap > room.max_rate_per_s2) {
+        if (am_cap > rl_.max_rate_per_s2) {
             const double f1 = room_down(am_cap);
             const double slope = std::max(0.0, (f0 - f1) / am_cap);
             const double guess = std::min(am_cap, f0 / (1 + slope));
-            am1 = guess < am_cap ? std::min(guess, room_down(guess)) : am_cap;
+            am1 = am_cap;
+            if (guess < am_cap) {
+                // Once more along the line through (guess, f(guess)) and (am_cap, f1): the room
+                // is not quite linear in |r''|, and the first crossing falls short of it.
+                const double fg = room_down(guess);
+                am1 = std::min(guess, fg);
+                const double s = (f1 - fg) / (am_cap - guess);
+                const double better = s < 0 ? (fg - s * guess) / (1 - s) : am_cap;
+                if (fg > guess && better > guess)
+                    am1 = std::max(am1, std::min(better, room_down(better)));
+            }
         }
         const double vm_move = std::clamp(rd_room, vm_acc, cfg_.max_rate / kRateRampS);
         auto try_move = [&](const RatePath& move, double am_hint) {
@@ -543,10 +553,13 @@ double Sampler::advance_rate_jerk(double target, double dt) noexcept {
                 whole.add(backup.pieces[static_cast<std::size_t>(i)]);
             if (whole.count >= RatePath::kMaxPieces || !rate_path_safe(whole)) return false;
             cert_ = backup;
-            last_limits_ = {vm_move, std::max(am_hint, room.max_rate_per_s2)};
+            // What the next periods' reach estimates (jerk_room_limits(), rate_cap_ahead())
+            // take as the r' to brake and the r'' to brake it with: the r' reached, not the cap.
+            last_limits_ = {std::max(std::fabs(end.rd), rl_.max_rate_per_s),
+                            std::max(am_hint, room.max_rate_per_s2)};
             return true;
         };
-        if (am1 > room.max_rate_per_s2) {
+        if (am1 > rl_.max_rate_per_s2) {
             RatePath move;
             ramp_path({r_, rd_}, kRampShare * vm_move, am1, dt, move);
             if (try_move(move, am1)) return apply_rate(move);
@@ -580,7 +593,7 @@ double Sampler::advance_rate_jerk(double target, double dt) noexcept {
                     RatePath head;
                     split_path(*path, dt, head);
                     cert_ = *path;
-                    last_limits_ = {vm_move, hint};
+                    last_limits_ = {std::max(-rd_, rl_.max_rate_per_s), hint};
                     return apply_rate(head);
                 }
             }
@@ -893,9 +906,8 @@ bool Sampler::coast_backup(double r, double rd, double tau, double am_hint, Rate
             const RateSpan box{std::max(0.0, r - std::max(-rd, 0.0) * h),
                                r + std::max(rd, 0.0) * h, std::min(rd, rd_to),
                                std::max(rd, rd_to), 0};
-            WalkFrom probe = at;
-            const SignedRoom room =
-                signed_jerk_room(tau, tau + box.r_hi * h + kWalkPadS, box, probe);
+            // `at` only moves past records wholly before tau, which never falls.
+            const SignedRoom room = signed_jerk_room(tau, tau + box.r_hi * h + kWalkPadS, box, at);
             // A hair inside: at the edge itself the check's sums round either way.
             return rd < 0 ? Span{room.up_min * (1 + 1e-6), std::min(room.up * (1 - 1e-6), cap)}
                           : Span{room.down_min * (1 + 1e-6), std::min(room.down * (1 - 1e-6), cap)};
