@@ -162,10 +162,9 @@ double ramp_distance_mm(double v0, double v1, const TangentLimits& lim) noexcept
     return (v0 + v1) / 2 * ramp_time_s(std::fabs(v1 - v0), lim);
 }
 
-double reachable_speed_mm_s(double v0, double length, const TangentLimits& lim) noexcept {
+double detail::reachable_speed_jerk_limited_mm_s(double v0, double length,
+                                                 const TangentLimits& lim) noexcept {
     double a = lim.acc_mm_s2;
-    if (length <= 0) return v0;
-    if (!jerk_limited(lim)) return std::sqrt(v0 * v0 + 2 * a * length);
     double j = lim.jerk_mm_s3;
     double c = a * a / j;  // speed change below which the ramp never reaches full acceleration
     // Jerk-limited branch: length = (2 v0 + x^2) x / sqrt(j) with x = sqrt(dv), a cubic

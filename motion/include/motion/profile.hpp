@@ -10,6 +10,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 namespace motion {
@@ -54,8 +55,22 @@ struct TangentLimits {
 double ramp_time_s(double dv_mm_s, const TangentLimits& lim) noexcept;
 // Distance covered by that ramp between speeds v0 and v1 (symmetric in v0, v1).
 double ramp_distance_mm(double v0_mm_s, double v1_mm_s, const TangentLimits& lim) noexcept;
+
+namespace detail {
+// reachable_speed_mm_s() for length_mm > 0 and lim.jerk_mm_s3 > 0.
+double reachable_speed_jerk_limited_mm_s(double v0_mm_s, double length_mm,
+                                         const TangentLimits& lim) noexcept;
+}  // namespace detail
+
 // Largest speed reachable (or from which v0 is reachable, by symmetry) within length_mm.
-double reachable_speed_mm_s(double v0_mm_s, double length_mm, const TangentLimits& lim) noexcept;
+// Inline without a jerk limit: the planner asks for it twice per element in every look-ahead
+// pass, and the call cost more than the root.
+inline double reachable_speed_mm_s(double v0_mm_s, double length_mm,
+                                   const TangentLimits& lim) noexcept {
+    if (length_mm <= 0) return v0_mm_s;
+    if (!(lim.jerk_mm_s3 > 0)) return std::sqrt(v0_mm_s * v0_mm_s + 2 * lim.acc_mm_s2 * length_mm);
+    return detail::reachable_speed_jerk_limited_mm_s(v0_mm_s, length_mm, lim);
+}
 
 // The fastest profile over length_mm from v_in to v_out not exceeding vcap. The caller
 // guarantees ramp_distance_mm(v_in, v_out) <= length_mm (up to rounding).
