@@ -883,10 +883,12 @@ Sampler::SignedRoom Sampler::signed_jerk_room(double from, double to, const Rate
     return {up, down, up_min, down_min, rd_down};
 }
 
-// Each piece halves r' (the last lands it on 0) at the room of the stretch it covers, guessed
-// from the previous piece's |r''| (am_hint for the first) and taken again over the range that
-// gives; with no room to brake while the rate falls, a piece coasts until r has fallen by a
-// quarter (the plan's j r^3 shrinks with it).
+// The first piece takes a quarter of r' (its check pairs r at its end with r' at its start, so
+// a short one passes next to the acceleration limit), the next ones half, the last the rest,
+// each at the room of the stretch it covers, guessed from the previous piece's |r''| (am_hint
+// for the first) and taken again over the range that gives, and cut shorter where the stretch
+// needs more than it allows; with no room to brake while the rate falls, a piece coasts until
+// r has fallen by a tenth (the plan's j r^3 shrinks with it).
 bool Sampler::coast_backup(double r, double rd, double tau, double am_hint, RatePath& out,
                            double& r_end) noexcept {
     constexpr int kMaxBrakePieces = 12;
