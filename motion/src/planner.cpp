@@ -434,14 +434,7 @@ OffsetFrame offset_frame(const AxisArray& t1, const AxisArray& t2, double cos_t,
         f.turn = std::min(f.turn, turn[k]);
         f.shift = std::max(f.shift, shift[k]);
     }
-    const JointLimits& jl = lim.joints;
-    for (int j = 0; j < jl.count; ++j) {
-        double dt = std::fabs(joint_component(jl, j, t2) - joint_component(jl, j, t1));
-        if (dt > 0) f.turn = std::min(f.turn, jl.acc_mm_s2[j] / dt);
-        f.shift = std::max(f.shift, std::max(std::fabs(joint_component(jl, j, f.n1)),
-                                             std::fabs(joint_component(jl, j, f.n2))) /
-                                        jl.acc_mm_s2[j]);
-    }
+    if (lim.joints.count > 0) joint_turn_and_shift(t1, t2, f.n1, f.n2, lim.joints, f.turn, f.shift);
     return f;
 }
 

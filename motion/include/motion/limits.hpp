@@ -14,6 +14,8 @@
 // every function here takes the smaller of what the axes and what the joints allow.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <span>
 
 #include "motion/geometry.hpp"
@@ -111,8 +113,23 @@ double rate_cap(const ElementBounds& b, const AxisLimits& lim, double v, double 
 
 // Highest speed at which a corner between the unit tangents t1 and t2 could be passed without
 // an axis or joint going faster than its velocity limit on either side: the smaller of cap and
-// every vel / max(|t1|, |t2|) (component-wise, joints through their rows).
-double pass_speed_cap(const AxisArray& t1, const AxisArray& t2, const AxisLimits& lim,
-                      double cap_mm_s) noexcept;
+// every vel / max(|t1|, |t2|) (component-wise, joints through their rows). Inline for the
+// planner's corners; the joints' part out of line.
+double joint_pass_speed_cap(const AxisArray& t1, const AxisArray& t2, const JointLimits& joints,
+                            double cap_mm_s) noexcept;
+inline double pass_speed_cap(const AxisArray& t1, const AxisArray& t2, const AxisLimits& lim,
+                             double cap_mm_s) noexcept {
+    for (int k = 0; k < kAxes; ++k) {
+        double t = std::max(std::fabs(t1[k]), std::fabs(t2[k]));
+        if (t > 0) cap_mm_s = std::min(cap_mm_s, lim.vel_mm_s[k] / t);
+    }
+    return lim.joints.count > 0 ? joint_pass_speed_cap(t1, t2, lim.joints, cap_mm_s) : cap_mm_s;
+}
+
+// An offset corner's frame (planner.cpp) over the joints: turn lowered to every joint's
+// acc / |(M (t2 - t1))_j|, shift raised to max(|(M n1)_j|, |(M n2)_j|) / acc.
+void joint_turn_and_shift(const AxisArray& t1, const AxisArray& t2, const AxisArray& n1,
+                          const AxisArray& n2, const JointLimits& joints, double& turn,
+                          double& shift) noexcept;
 
 }  // namespace motion
