@@ -257,6 +257,24 @@ void joint_turn_and_shift(const AxisArray& t1, const AxisArray& t2, const AxisAr
     }
 }
 
+IndependentShares independent_axes_shares(const AxisLimits& lim,
+                                          const std::array<bool, kAxes>& moving) noexcept {
+    IndependentShares out;
+    const JointLimits& jl = lim.joints;
+    for (int j = 0; j < jl.count; ++j) {
+        double vel = 0, acc = 0;  // what the moving axes could ask of joint j at their limits
+        for (int k = 0; k < kAxes; ++k) {
+            if (!moving[k]) continue;
+            const double m = std::fabs(jl.rows[j][k]);
+            vel += m * lim.vel_mm_s[k];
+            acc += m * lim.acc_mm_s2[k];
+        }
+        if (vel > jl.vel_mm_s[j]) out.vel = std::min(out.vel, jl.vel_mm_s[j] / vel);
+        if (acc > jl.acc_mm_s2[j]) out.acc = std::min(out.acc, jl.acc_mm_s2[j] / acc);
+    }
+    return out;
+}
+
 bool jerk_limited(const AxisLimits& lim) noexcept {
     auto any = [](const AxisArray& jerk, int n) {
         return std::any_of(jerk.begin(), jerk.begin() + n, [](double j) { return j > 0; });

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "motion/limits.hpp"
+
 namespace motion {
 
 void ProbeJog::start(const AxisArray& from_mm, const std::array<ProbeAxis, kProbeAxes>& axes,
@@ -19,6 +21,15 @@ void ProbeJog::start(const AxisArray& from_mm, const std::array<ProbeAxis, kProb
         ax.vmax_mm_s = limits.vel_mm_s[k];
         ax.state = ax.cfg.input >= 0 && ax.cfg.speed_mm_s != 0 ? State::Running : State::Off;
         ax.landing = false;
+    }
+    // A linear kinematics' joints (CoreXY: X and Y at once ask X + Y of motor A): the moving
+    // axes get the share of their limits that keeps every joint within its own.
+    std::array<bool, kAxes> moving{};
+    for (int k = 0; k < kProbeAxes; ++k) moving[k] = axes_[k].state == State::Running;
+    const IndependentShares share = independent_axes_shares(limits, moving);
+    for (Axis& ax : axes_) {
+        ax.acc_mm_s2 *= share.acc;
+        ax.vmax_mm_s *= share.vel;
     }
 }
 

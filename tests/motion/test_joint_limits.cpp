@@ -13,6 +13,7 @@
 #include "motion/geometry.hpp"
 #include "motion/kinematics.hpp"
 #include "motion/limits.hpp"
+#include "motion/probe_jog.hpp"
 
 namespace motion {
 namespace {
@@ -230,6 +231,46 @@ TEST(JointLimits, PassSpeedOfARightAngle) {
     EXPECT_NEAR(pass_speed_cap(xy(1 / kSqrt2, 1 / kSqrt2), xy(-1, 0), corexy_limits(), 500),
                 100 / kSqrt2, 1e-12);
     EXPECT_DOUBLE_EQ(pass_speed_cap(xy(1, 0), xy(0, 1), loose_axes(), 500), 500);
+}
+
+// The probe's conditional move (G904) moves each axis on its own. Probing X and Y at once at
+// 500 mm/s each (both inputs never come): X + Y could ask 2 x 1000 mm/s and 2 x 1e5 mm/s^2 of
+// motor A, so each axis gets 100 / 2000 of its velocity and 1000 / 2e5 of its acceleration:
+// 50 mm/s and 500 mm/s^2, motor A at 100 and 1000. X alone gets 100 / 1000: 100 mm/s.
+TEST(JointLimits, ProbeMovesShareTheMotorsBetweenTheirAxes) {
+    const AxisLimits lim = corexy_limits();
+    auto run = [&](bool with_y, double& peak_x, double& peak_a, double& peak_acc_a) {
+        std::array<ProbeAxis, kProbeAxes> axes{};
+        axes[0] = {0, true, 500, 50};
+        if (with_y) axes[1] = {1, true, 500, 50};
+        ProbeJog jog;
+        jog.start(AxisArray{}, axes, lim);
+        peak_x = peak_a = peak_acc_a = 0;
+        double prev_a = 0;
+        for (int n = 0; n < 10000 && !jog.finished(); ++n) {
+            jog.step(1e-3, 0, 1.0);
+            const double va = joint_component(lim.joints, 0, jog.vel_mm_s());
+            peak_x = std::max(peak_x, std::fabs(jog.vel_mm_s()[0]));
+            peak_a = std::max(peak_a, std::fabs(va));
+            peak_acc_a = std::max(peak_acc_a, std::fabs(va - prev_a) / 1e-3);
+            prev_a = va;
+        }
+        EXPECT_TRUE(jog.finished());
+        EXPECT_NEAR(jog.pos_mm()[0], 50, 1e-9);
+    };
+    double peak_x, peak_a, peak_acc_a;
+    run(true, peak_x, peak_a, peak_acc_a);
+    EXPECT_NEAR(peak_x, 50, 1e-9);
+    EXPECT_NEAR(peak_a, 100, 1e-9);
+    EXPECT_LE(peak_acc_a, 1000 * (1 + 1e-9));
+    run(false, peak_x, peak_a, peak_acc_a);
+    EXPECT_NEAR(peak_x, 100, 1e-9);
+    EXPECT_NEAR(peak_a, 100, 1e-9);
+    EXPECT_LE(peak_acc_a, 1000 * (1 + 1e-9));
+    // Without joints nothing is shared.
+    const IndependentShares none = independent_axes_shares(loose_axes(), {true, true});
+    EXPECT_EQ(none.vel, 1);
+    EXPECT_EQ(none.acc, 1);
 }
 
 TEST(JointLimits, IdentityRowsAtTheAxisLimitsChangeNothing) {

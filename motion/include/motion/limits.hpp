@@ -71,6 +71,17 @@ void for_each_limit(const AxisLimits& lim, F&& f) {
 // its own joints empty), for code written per axis that runs once more over joint_bounds().
 AxisLimits joint_space_limits(const JointLimits& joints) noexcept;
 
+// For axes that move each on its own (the probe's conditional move, ProbeJog), each at up to
+// the same share of its own velocity and acceleration limits: the largest shares (<= 1) that
+// keep every listed joint within its limits whatever the moving axes do (joint j sees at most
+// sum over moving k of |M_jk| share limit_k). {1, 1} without joints.
+struct IndependentShares {
+    double vel = 1;
+    double acc = 1;
+};
+IndependentShares independent_axes_shares(const AxisLimits& lim,
+                                          const std::array<bool, kAxes>& moving) noexcept;
+
 // The derivative bounds of element e as the listed joints see it, joint j in place of axis j:
 // the bounds of the element mapped through M, exact for every element kind (each kind's bounds
 // are functions of vectors that M maps linearly, e.g. a CoreXY 45 degree line: 2 for joint 0
