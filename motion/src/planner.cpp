@@ -69,6 +69,18 @@ constexpr double kOffsetMinCos = -0.02;
 constexpr double kShiftSpeedFactor = 3;
 constexpr double kShiftCentripetal = 0.5;
 constexpr double kShiftMinSpeedFactor = 2;
+// One-sided offset corners (one_sided_offset_corner): where one line has no room for a shift,
+// only the other is moved outwards, by kOffsetShare of the tolerance; the turn is the parabola
+// between that offset line and the other line as programmed. Up to 90 degrees its cut may be
+// (sqrt(P + d) + sqrt(P))^2 / sin(angle) for a proof limit P (see there); the first cut tried
+// is kOneSidedFirstShare of that (the turn is proved in two pieces split where it passes from
+// one line to the other, which holds at once up to 0.998 on the bench programs), then
+// kOneSidedShrink times less until every piece is proved, at most kOneSidedAttempts times.
+// Turns up to about 120 degrees (cos >= kOneSidedMinCos): past 90 degrees the proofs decide.
+constexpr double kOneSidedFirstShare = 0.995;
+constexpr double kOneSidedShrink = 0.96;
+constexpr int kOneSidedAttempts = 10;
+constexpr double kOneSidedMinCos = -0.5;
 // Offset corners with an arc (offset_arc_corner): a move's curvature moves the turn's deepest
 // point, so the cut shrinks by this factor until every piece is proved, at most this many times.
 constexpr double kOffsetArcShrink = 0.9;
@@ -243,7 +255,8 @@ void Planner::classify(const Piece& p, const Piece& next, Junction& jn) const {
         if (!jerk_mode_) {
             double l_tol = p.tolerance_mm / (kParabolaDeviationPerL * sin_angle);
             double l_geom = std::min(l, l_tol);
-            if (l_speed_mm > l_tol && l > l_tol && offset_corner(p, next, sin_angle, l_speed_mm, jn))
+            if (l_speed_mm > l_tol && l > l_tol &&
+                offset_corners(p, next, sin_angle, l_speed_mm, jn))
                 return;
             l = cut_for_speed(l_geom, l_speed_mm);
             if (l > kMinLength_mm) return jn.set(kInf, false, l, Blend::Parabola);
@@ -405,20 +418,24 @@ bool Planner::bezier_corner(const Piece& p, const Piece& next, double sin_angle,
     return true;
 }
 
-namespace {
-
 // What an offset corner between the unit tangents t1 and t2 (turning by the angle whose cosine
-// and sine are given) asks of the axes: the outward normals n1, n2 off the incoming and the
-// outgoing move (in their common plane); `turn`, the smallest A_k / |t2_k - t1_k|, which sets
-// the turn's speed; `shift`, the largest |n_k| / A_k, which sets the lane changes' length.
+// and sine are given, kept with it) asks of the axes: the outward normals n1, n2 off the
+// incoming and the outgoing move (in their common plane); `turn`, the smallest
+// A_k / |t2_k - t1_k|, which sets the turn's speed; `shift`, the largest |n_k| / A_k, which sets
+// the lane changes' length. (Declared in planner.hpp: classify() makes it once for both kinds of
+// offset corner between two lines.)
 struct OffsetFrame {
+    double cos_t, sin_t;
     AxisArray n1, n2;
     double turn = kInf, shift = 0;
 };
 
+namespace {
+
 OffsetFrame offset_frame(const AxisArray& t1, const AxisArray& t2, double cos_t, double sin_t,
                          const AxisLimits& lim) {
     OffsetFrame f;
+    f.cos_t = cos_t, f.sin_t = sin_t;
     // The axes' divisions first, with no branch, so that they are done two at a time (four
     // per axis, most of the frame's cost); then the smallest and largest, in axis order. A
     // turn of 0 in an axis gives acc / 0 = inf (acc > 0, validate()), which leaves the smallest
@@ -490,18 +507,27 @@ bool offset_cuts(double lp, double share, double tol, double sin_angle, double c
 // allows (docs/benchmarks.md, the acceleration-aware bound). The path is 2 d tan(angle / 2)
 // longer, the shifts need room on both lines, and each piece is proved within the tolerance
 // (bezier_within against the programmed lines); otherwise the caller uses the parabola.
-bool Planner::offset_corner(const Piece& p, const Piece& next, double sin_angle,
-                            double l_speed_mm, Junction& jn) const {
-    const AxisArray &t1 = p.geom.a, &t2 = next.geom.a, &c = p.geom.end;
+bool Planner::offset_corners(const Piece& p, const Piece& next, double sin_angle, double l_speed_mm,
+                             Junction& jn) const {
+    const AxisArray &t1 = p.geom.a, &t2 = next.geom.a;
     double cos_t = 0;
     for (int k = 0; k < kAxes; ++k) cos_t += t1[k] * t2[k];
-    if (cos_t < kOffsetMinCos) return false;
+    if (cos_t < kOneSidedMinCos) return false;
     const double sin_t = std::sqrt(std::max(0.0, 1 - cos_t * cos_t));
+    const OffsetFrame f = offset_frame(t1, t2, cos_t, sin_t, cfg_.limits);
+    return offset_corner(p, next, f, sin_angle, l_speed_mm, jn) ||
+           one_sided_offset_corner(p, next, f, sin_angle, l_speed_mm, jn);
+}
+
+bool Planner::offset_corner(const Piece& p, const Piece& next, const OffsetFrame& f,
+                            double sin_angle, double l_speed_mm, Junction& jn) const {
+    const AxisArray &t1 = p.geom.a, &t2 = next.geom.a, &c = p.geom.end;
+    const double cos_t = f.cos_t, sin_t = f.sin_t;
+    if (cos_t < kOffsetMinCos) return false;
     const double tol = p.tolerance_mm;
     // The parabola may now lie up to d + kOffsetShare tol from the offset lines. Room for the
     // shifts: what the first line has left after the corner at its start (known by now), half
     // of the second (the corner at its end may take the other half).
-    const OffsetFrame f = offset_frame(t1, t2, cos_t, sin_t, cfg_.limits);
     const AxisArray &n1 = f.n1, &n2 = f.n2;
     const double lp = offset_first_cut(kOffsetShare, tol, sin_angle, l_speed_mm);
     OffsetCuts cuts;
@@ -538,11 +564,236 @@ bool Planner::offset_corner(const Piece& p, const Piece& next, double sin_angle,
     if (!corner_piece_within(par, path, limit)) return false;
     jn.set(kInf, false, cut_before_mm, Blend::Offset);
     jn.cut_after_mm = cut_after_mm;
+    jn.has_shift_out = jn.has_shift_back = true;
     make_corner_bezier(out, path, jn.shift_out);
     make_corner_bezier(par, path, jn.curve);
     make_corner_bezier(in, path, jn.shift_back);
     jn.set_piece_axes(path);
     return true;
+}
+
+namespace {
+
+// A stretch of path for local_time_s: its length, speed cap and tangential acceleration (no
+// jerk limit).
+struct Stretch {
+    double length_mm, vcap_mm_s, acc_mm_s2;
+};
+
+// Time to run the stretches in turn, entering and leaving at v_ends_mm_s (or as fast as the
+// caps allow there), each at the fastest trapezoid the junction speeds leave it: the planner's
+// passes (plan_and_emit) on a few elements, to compare two ways of cutting one corner.
+template <std::size_t N>
+double local_time_s(const std::array<Stretch, N>& st, double v_ends_mm_s) {
+    // Junction speeds squared: the passes need no roots.
+    std::array<double, N + 1> v2;
+    auto sq = [](double x) { return x * x; };
+    v2[0] = sq(std::min(v_ends_mm_s, st[0].vcap_mm_s));
+    v2[N] = sq(std::min(v_ends_mm_s, st[N - 1].vcap_mm_s));
+    for (std::size_t i = 1; i < N; ++i) v2[i] = sq(std::min(st[i - 1].vcap_mm_s, st[i].vcap_mm_s));
+    for (std::size_t i = N; i-- > 0;)
+        v2[i] = std::min(v2[i], v2[i + 1] + 2 * st[i].acc_mm_s2 * st[i].length_mm);
+    for (std::size_t i = 0; i < N; ++i)
+        v2[i + 1] = std::min(v2[i + 1], v2[i] + 2 * st[i].acc_mm_s2 * st[i].length_mm);
+    double t = 0;
+    for (std::size_t i = 0; i < N; ++i) {
+        const double a = st[i].acc_mm_s2, len = st[i].length_mm;
+        const double peak2 = std::min(sq(st[i].vcap_mm_s), (2 * a * len + v2[i] + v2[i + 1]) / 2);
+        const double peak = std::sqrt(peak2);
+        const double ramps_mm = (2 * peak2 - v2[i] - v2[i + 1]) / (2 * a);
+        t += (2 * peak - std::sqrt(v2[i]) - std::sqrt(v2[i + 1])) / a +
+             std::max(0.0, len - ramps_mm) / peak;
+    }
+    return t;
+}
+
+// A line along the unit tangent t at `feed` (<= 0: none) on acc_share of each axis's and
+// listed joint's acceleration, as element_limits gives it (|p'| = |t|, p'' = 0), for x_mm of
+// it.
+Stretch line_stretch(const AxisArray& t, double x_mm, double feed, const AxisLimits& lim,
+                     double acc_share) {
+    Stretch st{x_mm, feed > 0 ? feed : kInf, kInf};
+    auto limit = [&](double g1, double vel, double acc) {
+        if (g1 == 0) return;
+        st.vcap_mm_s = std::min(st.vcap_mm_s, vel / g1);
+        st.acc_mm_s2 = std::min(st.acc_mm_s2, acc_share * acc / g1);
+    };
+    for (int k = 0; k < kAxes; ++k) limit(std::fabs(t[k]), lim.vel_mm_s[k], lim.acc_mm_s2[k]);
+    const JointLimits& jl = lim.joints;
+    for (int j = 0; j < jl.count; ++j)
+        limit(std::fabs(joint_component(jl, j, t)), jl.vel_mm_s[j], jl.acc_mm_s2[j]);
+    return st;
+}
+
+// bounds(make_parabola(c, t1, t2, l_mm)) without making it: its hodograph runs straight from
+// t1 to t2 (|p'_k| <= max(|t1_k|, |t2_k|)) and p'' = (t2 - t1) / 2l throughout.
+ElementBounds parabola_bounds(const AxisArray& t1, const AxisArray& t2, double l_mm) {
+    ElementBounds b;
+    int n = 0;
+    for (int k = 0; k < kAxes; ++k) {
+        b.g1[k] = b.linear[k] = std::max(std::fabs(t1[k]), std::fabs(t2[k]));
+        b.g2[k] = std::fabs(t2[k] - t1[k]) / (2 * l_mm);
+        b.g3[k] = b.tangential_in_plane[k] = 0;
+        if (b.g1[k] > 0 || b.g2[k] > 0) b.axes[n++] = static_cast<std::uint8_t>(k);
+    }
+    b.axis_count = n;
+    return b;
+}
+
+// Proved as corner_piece_within, in two pieces split at the parameter u (de Casteljau): a
+// parabola that lies near one line up to u and near the other after it is proved at once,
+// where halving it would split down to the depth limit around u.
+bool split_piece_within(const BezierPoints& b, double u, const CornerPath& path, double limit_mm) {
+    BezierPoints first, second;
+    for (int k = 0; k < kAxes; ++k) {
+        const double p01 = b.p0[k] + u * (b.p1[k] - b.p0[k]);
+        const double p12 = b.p1[k] + u * (b.p2[k] - b.p1[k]);
+        const double p23 = b.p2[k] + u * (b.p3[k] - b.p2[k]);
+        const double q0 = p01 + u * (p12 - p01), q1 = p12 + u * (p23 - p12);
+        const double m = q0 + u * (q1 - q0);
+        first.p0[k] = b.p0[k], first.p1[k] = p01, first.p2[k] = q0, first.p3[k] = m;
+        second.p0[k] = m, second.p1[k] = q1, second.p2[k] = p23, second.p3[k] = b.p3[k];
+    }
+    return corner_piece_within(first, path, limit_mm) &&
+           corner_piece_within(second, path, limit_mm);
+}
+
+}  // namespace
+
+// The one-sided offset corner (no jerk limit; two lines): where a line is too short for the
+// lane change offset_corner needs (a 0.5 mm step next to a row turn on tp_default), only the
+// other line is moved outwards by d, and the parabola turns between the moved line and the
+// other one as programmed: the shift lies on the long line, the short one keeps only the
+// parabola's cut. For a turn from +X onto +Y at the origin, with the line before it moved:
+// the offset line y = -d meets the line x = 0 at c2 = (0, -d); the parabola runs from
+// (-lp, -d) to (0, lp - d) with control point c2. In general the two offset lines, moved d1
+// along n1 and d2 along n2 (one of them 0), meet at c2 = c + d1 n1 + a t1 with
+// a = (d2 - d1 cos) / sin, which lies b = (d2 cos - d1) / sin along t2 from c (n1.t1 = 0,
+// n2.t1 = sin, n1.n2 = cos, n1.t2 = -sin). Every piece is proved within kOffsetProofShare of
+// the tolerance of the programmed lines (bezier_within); the cut shrinks until that holds, and
+// below the inside parabola's cut (no gain) the caller uses that parabola.
+bool Planner::one_sided_offset_corner(const Piece& p, const Piece& next, const OffsetFrame& f,
+                                      double sin_angle, double l_speed_mm, Junction& jn) const {
+    const AxisArray &t1 = p.geom.a, &t2 = next.geom.a, &c = p.geom.end;
+    const double cos_t = f.cos_t, sin_t = f.sin_t;
+    if (!(sin_t > 0)) return false;
+    const double tol = p.tolerance_mm;
+    const double room1 = p.geom.length_mm - p.trim_start_mm, room2 = max_trim_mm(next.geom, 0);
+    const double l_inside = tol / (kParabolaDeviationPerL * sin_angle);
+    const double d = kOffsetShare * tol;
+    const double keep = kShiftMinSpeedFactor / kShiftSpeedFactor;
+    const double limit = kOffsetProofShare * tol;
+    // The side with more room takes the shift (the other would have failed offset_corner).
+    const bool shift_before = room1 >= room2;
+    const double d1 = shift_before ? d : 0, d2 = shift_before ? 0 : d;
+    const double a = (d2 - d1 * cos_t) / sin_t, b = (d2 * cos_t - d1) / sin_t;
+    // It is used only where it is faster than the parabola inside the corner (classify) by
+    // the estimate local_time_s: its shift keeps part of the acceleration for turning (most
+    // where the shifted line is not along an axis), and the turn is longer.
+    // The lines run on for X1, X2 beyond the longest cuts, as far as ramping from the speed
+    // both allow takes: the estimate is the time from X1 before to X2 after the corner.
+    const double share = 1 - reserve_;
+    const double f1 = p.feed_mm_s, f2 = next.feed_mm_s;
+    const double turn_feed = f1 > 0 && f2 > 0 ? std::min(f1, f2) : std::max(f1, f2);
+    // A parabola cut l (the turn), on `centripetal` of the acceleration. Without joints
+    // element_limits reads only the element's kind (arc or not) besides the bounds, and the
+    // line p stands in for it (making one clears and fills 400 bytes a call); the joints' bounds
+    // it takes from the element itself (any parabola of that cut: they depend on its shape).
+    const LimitShares shares{share, share, 0};
+    auto parabola = [&](double l, double centripetal) {
+        const ElementBounds b = parabola_bounds(t1, t2, l);
+        LimitShares turning = shares;
+        turning.blend_centripetal = centripetal;
+        const ElementLimits lim =
+            cfg_.limits.joints.count > 0
+                ? element_limits(make_parabola(c, t1, t2, l), b, cfg_.limits, turn_feed, turning)
+                : element_limits(p.geom, b, cfg_.limits, turn_feed, turning);
+        return Stretch{2 * l, lim.vcap_mm_s, lim.tangent.acc_mm_s2};
+    };
+    const Stretch far1 = line_stretch(t1, 0, f1, cfg_.limits, share);
+    const Stretch far2 = line_stretch(t2, 0, f2, cfg_.limits, share);
+    const double v_ends = std::min(far1.vcap_mm_s, far2.vcap_mm_s);
+    const double x1 = room1 + v_ends * v_ends / (2 * far1.acc_mm_s2);
+    const double x2 = room2 + v_ends * v_ends / (2 * far2.acc_mm_s2);
+    auto line1 = [&](double cut_mm) {
+        return Stretch{x1 - cut_mm, far1.vcap_mm_s, far1.acc_mm_s2};
+    };
+    auto line2 = [&](double cut_mm) {
+        return Stretch{x2 - cut_mm, far2.vcap_mm_s, far2.acc_mm_s2};
+    };
+    // The parabola classify() would use, with close_piece's turning share.
+    const double l_par = cut_for_speed(
+        std::min(std::min(p.geom.length_mm, next.geom.length_mm) / 2, l_inside), l_speed_mm);
+    const bool isolated = room1 - l_par >= l_par && next.geom.length_mm / 2 >= 2 * l_par;
+    const Stretch inside = parabola(l_par, isolated ? kIsolatedBlendCentripetal : 0);
+    const double t_inside =
+        local_time_s(std::array<Stretch, 3>{line1(l_par), inside, line2(l_par)}, v_ends);
+    // The parabola from c2 - lp t1 to c2 + lp t2 (c2 on the programmed second line) is
+    // lp (1 - u)^2 sin from the second line and |lp u^2 sin - d| from the first: the smaller
+    // is largest where they are equal, within `limit` for lp sin up to
+    // (sqrt(limit + d) + sqrt(limit))^2 (the 90 degree case worked out in
+    // RightAngleOntoAShortLineIsCutOnTheLongLineMovedOutwards); the same with the lines'
+    // roles swapped.
+    const double deepest = std::sqrt(limit + d) + std::sqrt(limit);
+    double lp = std::min(kOneSidedFirstShare * deepest * deepest / sin_t,
+                         std::max(l_speed_mm, kSpeedCutFloor * tol));
+    for (int attempt = 0; attempt < kOneSidedAttempts && lp > l_inside;
+         ++attempt, lp *= kOneSidedShrink) {
+        if (!(lp > a && lp + b > 0)) continue;
+        // The shift passes at kShiftSpeedFactor times the turn's speed, as in offset_cuts, and
+        // takes the room its line leaves after the turn's cut.
+        const double v_corner_mm_s = std::sqrt(2 * lp * f.turn);
+        const double ls_full =
+            kShiftSpeedFactor * v_corner_mm_s * std::sqrt(6 * d * f.shift / kShiftCentripetal);
+        const double on1 = lp - a, on2 = lp + b;  // the turn's cut on each line
+        const double ls = std::min(ls_full, (shift_before ? room1 - on1 : room2 - on2));
+        if (ls < keep * ls_full || (shift_before ? on2 > room2 : on1 > room1)) continue;
+        const double before_mm = on1 + (shift_before ? ls : 0);
+        const double after_mm = on2 + (shift_before ? 0 : ls);
+        AxisArray c2;
+        BezierPoints par, shift;
+        for (int k = 0; k < kAxes; ++k) {
+            c2[k] = c[k] + d1 * f.n1[k] + a * t1[k];
+            par.p0[k] = c2[k] - lp * t1[k];
+            par.p3[k] = c2[k] + lp * t2[k];
+            par.p1[k] = par.p0[k] + 2 * lp / 3 * t1[k];
+            par.p2[k] = par.p3[k] - 2 * lp / 3 * t2[k];
+        }
+        // The parabola is nearer the moved line before u (where u^2 lp sin - d1 = (1 - u)^2 lp
+        // sin - d2 for the distances from the moved lines) and the other one after it.
+        const double u_cross = std::clamp((1 + (d1 - d2) / (lp * sin_t)) / 2, 0.0625, 0.9375);
+        const CornerPath path = corner_path(p.geom, before_mm, next.geom, after_mm, tol);
+        if (!split_piece_within(par, u_cross, path, limit)) continue;
+        if (shift_before) {
+            AxisArray a0;
+            for (int k = 0; k < kAxes; ++k) a0[k] = par.p0[k] - ls * t1[k] - d1 * f.n1[k];
+            if (!shift_bezier_within(a0, t1, par.p0, t1, ls / 2, path, limit, shift)) continue;
+        } else {
+            AxisArray b3;
+            for (int k = 0; k < kAxes; ++k) b3[k] = par.p3[k] + ls * t2[k] - d2 * f.n2[k];
+            if (!shift_bezier_within(par.p3, t2, b3, t2, ls / 2, path, limit, shift)) continue;
+        }
+        Element& shift_e = shift_before ? jn.shift_out : jn.shift_back;
+        make_corner_bezier(shift, path, shift_e);
+        const ElementLimits shift_lim =
+            element_limits(shift_e, bounds(shift_e), cfg_.limits, shift_before ? f1 : f2,
+                           {share, share, kShiftCentripetal});
+        const Stretch shifted{shift_e.length_mm, shift_lim.vcap_mm_s, shift_lim.tangent.acc_mm_s2};
+        const Stretch turn = parabola(lp, kIsolatedBlendCentripetal);
+        const double t_one_sided = local_time_s(
+            shift_before ? std::array<Stretch, 4>{line1(before_mm), shifted, turn, line2(after_mm)}
+                         : std::array<Stretch, 4>{line1(before_mm), turn, shifted, line2(after_mm)},
+            v_ends);
+        if (!(t_one_sided < t_inside)) return false;
+        make_corner_bezier(par, path, jn.curve);
+        jn.set(kInf, false, before_mm, Blend::Offset);
+        jn.cut_after_mm = after_mm;
+        jn.has_shift_out = shift_before;
+        jn.has_shift_back = !shift_before;
+        jn.set_piece_axes(path);
+        return true;
+    }
+    return false;
 }
 
 namespace {
@@ -684,6 +935,7 @@ bool Planner::offset_arc_corner(const Piece& p, const Piece& next, double sin_an
             continue;
         jn.set(kInf, false, c.before_mm, Blend::Offset);
         jn.cut_after_mm = c.after_mm;
+        jn.has_shift_out = jn.has_shift_back = true;
         make_corner_bezier(out, path, jn.shift_out);
         make_corner_bezier(bend, path, jn.curve);
         make_corner_bezier(in, path, jn.shift_back);
@@ -700,10 +952,12 @@ void Planner::close_piece(Piece& p, Piece* next) {
     else
         jn.set(0, false, 0);
     bool rough = p.rough_start || jn.rough;
-    // A Bezier corner, or an offset corner's shift, starts where the move is cut (evaluated there).
-    const AxisArray* blend_start = jn.blend == Blend::Curve    ? &jn.curve.origin
-                                   : jn.blend == Blend::Offset ? &jn.shift_out.origin
-                                                               : nullptr;
+    // A Bezier corner, or an offset corner's first piece (its shift, or the turn of a one-sided
+    // one moved only after it), starts where the move is cut (evaluated there).
+    const AxisArray* blend_start = nullptr;
+    if (jn.blend == Blend::Curve) blend_start = &jn.curve.origin;
+    if (jn.blend == Blend::Offset)
+        blend_start = jn.has_shift_out ? &jn.shift_out.origin : &jn.curve.origin;
     Element e = trimmed(p.geom, p.trim_start_mm, jn.blend_l_mm, blend_start);
     // Only a line blended at both ends can vanish, and its junctions are smooth.
     if (e.length_mm > kMinLength_mm) add_item(e, p.feed_mm_s, jn.cap_mm_s, rough, p, p.rapid);
@@ -725,12 +979,14 @@ void Planner::close_piece(Piece& p, Piece* next) {
             // it belongs to the next move, as the turn does, like every blend (synchronised
             // outputs switch where it starts): the move is left where the tool leaves its path.
             const Piece& shift_owner = p.geom.kind == ElementKind::Line ? p : *next;
-            add_item(jn.shift_out, p.feed_mm_s, kInf, false, shift_owner, p.rapid,
-                     kShiftCentripetal, jn.moving_axes());
+            if (jn.has_shift_out)
+                add_item(jn.shift_out, p.feed_mm_s, kInf, false, shift_owner, p.rapid,
+                         kShiftCentripetal, jn.moving_axes());
             add_item(jn.curve, feed, kInf, false, *next, rapid, kIsolatedBlendCentripetal,
                      jn.moving_axes());
-            add_item(jn.shift_back, next->feed_mm_s, kInf, false, *next, next->rapid,
-                     kShiftCentripetal, jn.moving_axes());
+            if (jn.has_shift_back)
+                add_item(jn.shift_back, next->feed_mm_s, kInf, false, *next, next->rapid,
+                         kShiftCentripetal, jn.moving_axes());
             next->trim_start_mm = jn.cut_after_mm;
             next->rough_start = false;
             return;

@@ -68,6 +68,15 @@ struct Gen {
         add_line(std::pow(10, uni(-3.5, 1.5)), d, rotary && u(rng) < 0.1);
     }
 
+    // The current direction turned by `angle`, half the time within the XY plane (as most
+    // programs' corners are).
+    Vec3 turn_by(double angle) {
+        if (u(rng) < 0.5 || std::hypot(dir[0], dir[1]) < 0.3) return turn(dir, angle, rng);
+        const Vec3 flat = normalized({dir[0], dir[1], 0});
+        const double a = std::atan2(flat[1], flat[0]) + (u(rng) < 0.5 ? angle : -angle);
+        return {std::cos(a), std::sin(a), 0};
+    }
+
     // A run of very short, nearly collinear moves (a finely sampled curve).
     void fine_chain() {
         int n = 20 + int(u(rng) * 60);
@@ -135,6 +144,16 @@ Program random_program(std::mt19937_64& rng, const GenOptions& opt) {
     if (g.u(rng) < 0.5) g.dir = normalized({g.dir[0], g.dir[1], 0});
     while (int(g.prog.segs.size()) < opt.count) {
         double r = g.u(rng);
+        if (opt.line_corners) {
+            const bool short_line = g.u(rng) < 0.5;
+            g.add_line(short_line ? g.uni(0.1, 0.8) : g.uni(2, 20),
+                       g.turn_by(g.uni(kPi / 6, kPi * 13 / 18)), false);
+            static const double tols[] = {0.002, 0.01, 0.05, 0.2};
+            PathSegment& s = g.prog.segs.back();
+            s.tolerance_mm = tols[std::uniform_int_distribution<int>(0, 3)(rng)];
+            s.exact_stop = s.rapid = false;
+            continue;
+        }
         if (opt.arc_corners) {
             if (r < 0.3)
                 g.line(false);

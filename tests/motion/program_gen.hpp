@@ -25,6 +25,10 @@ struct GenOptions {
     // Mostly arcs (and some lines) meeting at kinks, each corner with a tolerance > 0 and no
     // exact stops: the corners with arcs that the planner blends.
     bool arc_corners = false;
+    // Lines only, long (2-20 mm) and short (0.1-0.8 mm) at random, meeting at 30-130 degree
+    // turns, each corner with a tolerance > 0, no exact stops or rapids: the corners next to a
+    // short line that the planner cuts one-sided (one_sided_offset_corner).
+    bool line_corners = false;
 };
 
 Program random_program(std::mt19937_64& rng, const GenOptions& opt);

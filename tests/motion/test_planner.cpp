@@ -176,16 +176,18 @@ TEST(Planner, BlendedRightAngleIsCutOnOffsetLinesWithoutJerkLimit) {
 }
 
 // Where the lines leave no room for the shifts the corner is the parabola cut inside it, from
-// l = 4 tol before to l after the corner, with pseudo length 2 l.
+// l = 4 tol before to l after the corner, with pseudo length 2 l. (A one-sided offset corner
+// would need a shift of at least 2 x its turn's speed, 2 x 3 x 10.6 mm/s x sqrt(6 x 0.0099 /
+// (0.5 x 1000)) / 3 = 0.23 mm, on a line that keeps 0.2 - 0.056 mm.)
 TEST(Planner, BlendedRightAngleBetweenShortLinesIsTheParabolaWithoutJerkLimit) {
     PlannerConfig cfg = uniform(100, 1000, 0);
     const double tol = 0.01;
-    auto recs = plan(cfg, {line_to({0.5}, 50, tol, 0), line_to({0.5, 0.5}, 50, tol, 1)});
+    auto recs = plan(cfg, {line_to({0.2}, 50, tol, 0), line_to({0.2, 0.2}, 50, tol, 1)});
     ASSERT_EQ(recs.size(), 3u);
     ASSERT_EQ(recs[1].geom.kind, ElementKind::Bezier);
     double l = 4 * tol;
     EXPECT_NEAR(recs[1].geom.length_mm, 2 * l, 1e-12);
-    EXPECT_NEAR(recs[0].geom.length_mm, 0.5 - l, 1e-12);
+    EXPECT_NEAR(recs[0].geom.length_mm, 0.2 - l, 1e-12);
     // Constant acceleration |dT_k| / 2l v^2 per axis; the lines keep more than 2l, so the
     // blend is isolated and turns with 0.99 of the usable 990 mm/s^2: 8.855 mm/s.
     double v = std::sqrt(0.99 * 990 * 2 * l);
@@ -216,6 +218,56 @@ TEST(Planner, BlendsInAChainOfShortMovesKeepAShareForSpeedChanges) {
     EXPECT_EQ(blends, 39);
     // The middle of the zigzag runs at that speed.
     EXPECT_NEAR(recs[recs.size() / 2].profile.peak_v_mm_s, v, 1e-9);
+}
+
+// A right angle from a long line onto a 0.5 mm one (which continues straight on): the short
+// line has no room for the lane change back (offset_corner needs >= 0.27 mm of it beyond the
+// turn), so only the long line is moved outwards, by d = 0.99 tol (one_sided_offset_corner).
+// Turning from +X onto +Y at (10, 0), the offset line y = -d meets x = 10 at c2 = (10, -d), and
+// the parabola runs from (10 - lp, -d) to (10, lp - d): its distance from the lines is
+// min(u^2 lp - d, lp (1 - u)^2), largest where the two are equal, (lp - d)^2 / (4 lp). That is
+// P' = 0.995 tol (the proof's limit) for lp = (sqrt(P' + d) + sqrt(P'))^2 = 5.79 tol; the cut
+// taken is 0.995 x that, 1.44 x the inside parabola's 4 tol, whose distance is 0.988 tol. The
+// shift is cut as offset_corner's: 3 x the turn's speed sqrt(2 lp A) on half the acceleration.
+TEST(Planner, RightAngleOntoAShortLineIsCutOnTheLongLineMovedOutwards) {
+    PlannerConfig cfg = uniform(100, 1000, 0);
+    const double tol = 0.01;
+    auto recs = plan(cfg, {line_to({10}, 50, tol, 0), line_to({10, 0.5}, 50, tol, 1),
+                           line_to({10, 10.5}, 50, tol, 2)});
+    ASSERT_EQ(recs.size(), 5u);
+    const double d = 0.99 * tol;
+    const double limit = 0.995 * tol;
+    const double lp = 0.995 * std::pow(std::sqrt(limit + d) + std::sqrt(limit), 2);
+    EXPECT_NEAR(lp, 5.7618 * tol, 1e-4 * tol);
+    EXPECT_NEAR((lp - d) * (lp - d) / (4 * lp), 0.98797 * tol, 1e-5 * tol);
+    const double ls = 3 * std::sqrt(2 * lp * 1000) * std::sqrt(6 * d / (0.5 * 1000));
+    // The long line, the shift along it, the turn (the next move's, as blends are), the rest of
+    // the short line (it keeps all but lp - d: the turn ends d short of lp past the corner).
+    EXPECT_EQ(recs[0].geom.kind, ElementKind::Line);
+    EXPECT_EQ(recs[1].geom.kind, ElementKind::Bezier);
+    EXPECT_EQ(recs[2].geom.kind, ElementKind::Bezier);
+    EXPECT_EQ(recs[3].geom.kind, ElementKind::Line);
+    EXPECT_EQ(recs[1].line, 0);
+    EXPECT_EQ(recs[2].line, 1);
+    EXPECT_NEAR(recs[0].geom.length_mm, 10 - lp - ls, 1e-12);
+    EXPECT_NEAR(recs[2].geom.length_mm, 2 * lp, 1e-12);
+    EXPECT_NEAR(recs[3].geom.length_mm, 0.5 - (lp - d), 1e-12);
+    EXPECT_NEAR(recs[4].geom.length_mm, 10, 1e-12);
+    // The turn runs at sqrt(0.99 x 990 x 2 lp) = 10.627 mm/s, 1.2 x the 8.855 mm/s of the
+    // parabola inside the corner.
+    const double v = std::sqrt(0.99 * 990 * 2 * lp);
+    EXPECT_NEAR(recs[2].profile.peak_v_mm_s, v, 1e-9);
+    EXPECT_NEAR(v, 10.627, 0.001);
+    EXPECT_GT(v, 1.2 * std::sqrt(0.99 * 990 * 2 * 4 * tol));
+    // d outside the long line along the shift; never beyond 0.995 tol, never in the quadrant
+    // x > 10, y < 0 (right_angle_deviation counts that as 1e9).
+    EXPECT_NEAR(right_angle_deviation(recs[1]), d, 1e-6);
+    EXPECT_NEAR(right_angle_deviation(recs[2]), d, 1e-6);
+    MotionSample start = sample(recs[2], 0), end = sample(recs[2], recs[2].profile.duration_s);
+    EXPECT_NEAR(start.pos_mm[0], 10 - lp, 1e-12);
+    EXPECT_NEAR(start.pos_mm[1], -d, 1e-12);
+    EXPECT_NEAR(end.pos_mm[0], 10, 1e-12);
+    EXPECT_NEAR(end.pos_mm[1], lp - d, 1e-12);
 }
 
 // A rapid into a slow feed move: the blend runs at the feed (4 mm/s), so it is cut only as long
@@ -253,11 +305,12 @@ TEST(Planner, ReversalIsAnExactStopAtItsEndPoint) {
 }
 
 // Past 90 degrees of turn the cut is l = tol / ((1/4) |T2 - T1| / sqrt(2)), so the parabola
-// misses the corner point by |T2 - T1| l / 4 = sqrt(2) tol, as at a right angle.
+// misses the corner point by |T2 - T1| l / 4 = sqrt(2) tol, as at a right angle. (135 degrees:
+// past the 120 degrees up to which a one-sided offset corner is tried.)
 TEST(Planner, SharpTurnBlendMissesTheCornerPointByNoMoreThanARightAngle) {
     PlannerConfig cfg = uniform(100, 1000, 0);
     const double tol = 0.01;
-    const double c = std::cos(2 * M_PI / 3), s = std::sin(2 * M_PI / 3);
+    const double c = std::cos(3 * M_PI / 4), s = std::sin(3 * M_PI / 4);
     auto recs = plan(cfg, {line_to({10}, 50, tol, 0), line_to({10 + 10 * c, 10 * s}, 50, tol, 1)});
     ASSERT_EQ(recs.size(), 3u);
     ASSERT_EQ(recs[1].geom.kind, ElementKind::Bezier);

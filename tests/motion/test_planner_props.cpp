@@ -161,6 +161,20 @@ TEST_P(RandomPrograms, ArcCornersStayWithinLimitsAndToleranceAndEndExactly) {
     expect_clean_finish(play(cfg, prog, nullptr, {}), prog, seed);
 }
 
+// Line corners next to short lines (cut on offset lines, one-sided where a line is short):
+// long and short lines at 30-130 degree turns, every corner with a tolerance, no jerk limit
+// (offset corners are made only without one) but the limits and feeds of the other tests.
+TEST_P(RandomPrograms, LineCornersNextToShortLinesStayWithinLimitsAndToleranceAndEndExactly) {
+    const std::uint64_t seed = GetParam();
+    std::mt19937_64 rng(seed * 104729 + 17);
+    GenOptions opt;
+    opt.count = 30;
+    opt.line_corners = true;
+    Program prog = random_program(rng, opt);
+    PlannerConfig cfg = config(rng, false, seed % 4 < 2 ? 4096 : 6);
+    expect_clean_finish(play(cfg, prog, nullptr, {}), prog, seed);
+}
+
 INSTANTIATE_TEST_SUITE_P(Seeds, RandomPrograms, ::testing::Range<std::uint64_t>(1, 31));
 
 }  // namespace

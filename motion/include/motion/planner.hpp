@@ -37,6 +37,8 @@
 
 namespace motion {
 
+struct OffsetFrame;  // planner.cpp: what an offset corner between two tangents asks of the axes
+
 struct PlannerConfig {
     AxisLimits limits;
     double servo_period_s = 1e-3;
@@ -147,6 +149,7 @@ class Planner {
         // equals the corner's in the others), else none; see bounds(e, moving).
         std::array<int, kAxes> piece_axes;
         int piece_axis_count = 0;
+        bool has_shift_out = true, has_shift_back = true;  // one-sided: only one of them
 
         void set(double cap, bool is_rough, double l_mm, Blend kind = Blend::None) {
             cap_mm_s = cap, rough = is_rough, blend_l_mm = l_mm, blend = kind;
@@ -169,10 +172,18 @@ class Planner {
     // l_speed_mm: the longest cut worth making (see classify).
     bool bezier_corner(const Piece& p, const Piece& next, double sin_angle, double feed_mm_s,
                        double l_speed_mm, Junction& jn) const;
+    // The corner of two lines cut on lines moved outwards (offset_corner, else
+    // one_sided_offset_corner) written into jn, or false (as above) when neither fits.
+    bool offset_corners(const Piece& p, const Piece& next, double sin_angle, double l_speed_mm,
+                        Junction& jn) const;
     // The corner of two lines cut on lines moved outwards (see planner.cpp) written into jn, or
-    // false (as above) when that does not fit.
-    bool offset_corner(const Piece& p, const Piece& next, double sin_angle, double l_speed_mm,
-                       Junction& jn) const;
+    // false (as above) when that does not fit; f: offset_frame() of the lines' tangents.
+    bool offset_corner(const Piece& p, const Piece& next, const OffsetFrame& f, double sin_angle,
+                       double l_speed_mm, Junction& jn) const;
+    // The same with only one line moved outwards, for a corner where the other line has no
+    // room for a shift (see planner.cpp), or false when that does not fit.
+    bool one_sided_offset_corner(const Piece& p, const Piece& next, const OffsetFrame& f,
+                                 double sin_angle, double l_speed_mm, Junction& jn) const;
     // The same for a corner where one or both moves are arcs or helices (the moves carried
     // outwards with their curvature, see planner.cpp), or false when that does not fit.
     bool offset_arc_corner(const Piece& p, const Piece& next, double sin_angle, double l_speed_mm,
