@@ -23,6 +23,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "../machine_program_ini.hpp"
@@ -1047,9 +1048,19 @@ class Motion : public hal::Instance {
         const std::vector<motion::AxisArray> rows = kins_.kins().linear_map();
         if (rows.empty()) return;
         std::vector<motion::JointLimit> joints(joint_count_);
-        for (std::size_t j = 0; j < joint_count_; ++j)
+        for (std::size_t j = 0; j < joint_count_; ++j) {
             joints[j] = {joint_max_velocity_[j].get(), joint_max_acceleration_[j].get(),
                          joint_max_jerk_[j].get()};
+            const std::pair<const char*, double> given[] = {
+                {"max-velocity", joints[j].vel_mm_s},
+                {"max-acceleration", joints[j].acc_mm_s2},
+                {"max-jerk", joints[j].jerk_mm_s3}};
+            for (const auto& [param, value] : given)
+                if (!(value >= 0) || !std::isfinite(value))
+                    throw hal::Error(
+                        fmt::format("{}: {} = {}: a joint limit must be >= 0 (0 = unlimited)",
+                                    name(), pin_name(fmt::format("joint.{}.{}", j, param)), value));
+        }
         try {
             motion::set_linear_joints(limits, rows, joints);
         } catch (const std::invalid_argument& e) {

@@ -109,4 +109,20 @@ TEST(CncRunCoreXYMotors, APocketWithJerkLimitsReportsNoMotorExcess) {
     EXPECT_NE(r.out.find("result: finished"), std::string::npos) << r.out;
 }
 
+TEST(CncRunCoreXYMotors, ANegativeMotorLimitIsRefusedBeforeAnythingMoves) {
+    ScratchDir scratch;
+    std::string ini =
+        cnc_test::sim_ini("corexy", [](const std::string& section, std::string& line) {
+            if (section == "JOINT_0" && line.rfind("MAX_ACCELERATION = ", 0) == 0)
+                line = "MAX_ACCELERATION = -5";
+        });
+    const RunResult r = run_text(scratch, ini, "G90 G21\nG01 X10 F600\nM30\n");
+    EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+    EXPECT_NE(r.err.find("motion.0: joint.0.max-acceleration = -5: a joint limit must be >= 0 "
+                         "(0 = unlimited)"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(r.out.find("motion time"), std::string::npos) << r.out;  // never started
+}
+
 }  // namespace
