@@ -827,7 +827,9 @@ bool bezier_within(const BezierPoints& bezier, const CornerPath& path, double li
     return hull_within(path, limit_mm, still_axes2, piece, dims);
 }
 
-bool corner_piece_within(const BezierPoints& b, const CornerPath& path, double limit_mm) noexcept {
+namespace {
+
+bool piece_within(const BezierPoints& b, const CornerPath& path, double limit_mm, Whole whole) {
     // bezier_within would find every still axis still, at distance (p0 - fixed)^2 = 0.
     if (!path.still_at_rest) return bezier_within(b, path, limit_mm);
     Hull piece;
@@ -836,7 +838,17 @@ bool corner_piece_within(const BezierPoints& b, const CornerPath& path, double l
         piece[0][j] = b.p0[k], piece[1][j] = b.p1[k];
         piece[2][j] = b.p2[k], piece[3][j] = b.p3[k];
     }
-    return hull_within(path, limit_mm, 0, piece, path.dims);
+    return hull_within(path, limit_mm, 0, piece, path.dims, whole);
+}
+
+}  // namespace
+
+bool corner_piece_within(const BezierPoints& b, const CornerPath& path, double limit_mm) noexcept {
+    return piece_within(b, path, limit_mm, Whole::Skip);
+}
+
+bool corner_part_within(const BezierPoints& b, const CornerPath& path, double limit_mm) noexcept {
+    return piece_within(b, path, limit_mm, Whole::Try);
 }
 
 namespace {

@@ -641,8 +641,9 @@ ElementBounds parabola_bounds(const AxisArray& t1, const AxisArray& t2, double l
 }
 
 // Proved as corner_piece_within, in two pieces split at the parameter u (de Casteljau): a
-// parabola that lies near one line up to u and near the other after it is proved at once,
-// where halving it would split down to the depth limit around u.
+// parabola that lies near one line up to u and near the other after it is proved at once
+// (each piece's hull near one chord as a whole, corner_part_within), where halving it would
+// split down to the depth limit around u.
 bool split_piece_within(const BezierPoints& b, double u, const CornerPath& path, double limit_mm) {
     BezierPoints first, second;
     for (int k = 0; k < kAxes; ++k) {
@@ -654,8 +655,7 @@ bool split_piece_within(const BezierPoints& b, double u, const CornerPath& path,
         first.p0[k] = b.p0[k], first.p1[k] = p01, first.p2[k] = q0, first.p3[k] = m;
         second.p0[k] = m, second.p1[k] = q1, second.p2[k] = p23, second.p3[k] = b.p3[k];
     }
-    return corner_piece_within(first, path, limit_mm) &&
-           corner_piece_within(second, path, limit_mm);
+    return corner_part_within(first, path, limit_mm) && corner_part_within(second, path, limit_mm);
 }
 
 }  // namespace

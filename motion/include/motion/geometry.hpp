@@ -217,6 +217,12 @@ bool shift_bezier_within(const AxisArray& p0, const AxisArray& t1, const AxisArr
 // proof runs in the path's axes only.
 bool corner_piece_within(const BezierPoints& b, const CornerPath& path, double limit_mm) noexcept;
 
+// corner_piece_within() with the same result, for a piece that may lie near one chord as a
+// whole (a one-sided offset corner's turn split where it passes from one move to the other,
+// Planner::one_sided_offset_corner): when path.still_at_rest the whole hull is tried against
+// each chord first, as shift_bezier_within does (Proof::surely_near_chord in geometry.cpp).
+bool corner_part_within(const BezierPoints& b, const CornerPath& path, double limit_mm) noexcept;
+
 // out = make_bezier(b.p0, b.p1, b.p2, b.p3), written in place, for points corner_bezier_within()
 // gave for this path (or any whose points equal path.fixed in the still axes, as for
 // corner_piece_within): when path.still_at_rest they do not differ in the still axes, so the
