@@ -184,6 +184,7 @@ void Planner::push(const PathSegment& seg) {
         seg.move_id,
         0,
         false,
+        !have_pending_,
     };
     if (next.geom.length_mm < kMinLength_mm) {
         if (have_pending_) pieces_[pending_].exact_stop |= seg.exact_stop;
@@ -580,16 +581,17 @@ struct Stretch {
     double length_mm, vcap_mm_s, acc_mm_s2;
 };
 
-// Time to run the stretches in turn, entering and leaving at v_ends_mm_s (or as fast as the
-// caps allow there), each at the fastest trapezoid the junction speeds leave it: the planner's
-// passes (plan_and_emit) on a few elements, to compare two ways of cutting one corner.
+// Time to run the stretches in turn, entering at v_in_mm_s and leaving at v_out_mm_s (or as
+// fast as the caps allow there), each at the fastest trapezoid the junction speeds leave it:
+// the planner's passes (plan_and_emit) on a few elements, to compare two ways of cutting one
+// corner.
 template <std::size_t N>
-double local_time_s(const std::array<Stretch, N>& st, double v_ends_mm_s) {
+double local_time_s(const std::array<Stretch, N>& st, double v_in_mm_s, double v_out_mm_s) {
     // Junction speeds squared: the passes need no roots.
     std::array<double, N + 1> v2;
     auto sq = [](double x) { return x * x; };
-    v2[0] = sq(std::min(v_ends_mm_s, st[0].vcap_mm_s));
-    v2[N] = sq(std::min(v_ends_mm_s, st[N - 1].vcap_mm_s));
+    v2[0] = sq(std::min(v_in_mm_s, st[0].vcap_mm_s));
+    v2[N] = sq(std::min(v_out_mm_s, st[N - 1].vcap_mm_s));
     for (std::size_t i = 1; i < N; ++i) v2[i] = sq(std::min(st[i - 1].vcap_mm_s, st[i].vcap_mm_s));
     for (std::size_t i = N; i-- > 0;)
         v2[i] = std::min(v2[i], v2[i + 1] + 2 * st[i].acc_mm_s2 * st[i].length_mm);
@@ -713,7 +715,10 @@ bool Planner::one_sided_offset_corner(const Piece& p, const Piece& next, const O
     const Stretch far1 = line_stretch(t1, 0, f1, cfg_.limits, share);
     const Stretch far2 = line_stretch(t2, 0, f2, cfg_.limits, share);
     const double v_ends = std::min(far1.vcap_mm_s, far2.vcap_mm_s);
-    const double x1 = room1 + v_ends * v_ends / (2 * far1.acc_mm_s2);
+    // A line that starts at rest (the program's first move, or after a stop) is entered at
+    // rest where it starts.
+    const double v_in = p.start_at_rest ? 0 : v_ends;
+    const double x1 = room1 + (p.start_at_rest ? 0 : v_ends * v_ends / (2 * far1.acc_mm_s2));
     const double x2 = room2 + v_ends * v_ends / (2 * far2.acc_mm_s2);
     auto line1 = [&](double cut_mm) {
         return Stretch{x1 - cut_mm, far1.vcap_mm_s, far1.acc_mm_s2};
@@ -727,7 +732,7 @@ bool Planner::one_sided_offset_corner(const Piece& p, const Piece& next, const O
     const bool isolated = room1 - l_par >= l_par && next.geom.length_mm / 2 >= 2 * l_par;
     const Stretch inside = parabola(l_par, isolated ? kIsolatedBlendCentripetal : 0);
     const double t_inside =
-        local_time_s(std::array<Stretch, 3>{line1(l_par), inside, line2(l_par)}, v_ends);
+        local_time_s(std::array<Stretch, 3>{line1(l_par), inside, line2(l_par)}, v_in, v_ends);
     // The parabola from c2 - lp t1 to c2 + lp t2 (c2 on the programmed second line) is
     // lp (1 - u)^2 sin from the second line and |lp u^2 sin - d| from the first: the smaller
     // is largest where they are equal, within `limit` for lp sin up to
@@ -783,7 +788,7 @@ bool Planner::one_sided_offset_corner(const Piece& p, const Piece& next, const O
         const double t_one_sided = local_time_s(
             shift_before ? std::array<Stretch, 4>{line1(before_mm), shifted, turn, line2(after_mm)}
                          : std::array<Stretch, 4>{line1(before_mm), turn, shifted, line2(after_mm)},
-            v_ends);
+            v_in, v_ends);
         if (!(t_one_sided < t_inside)) return false;
         make_corner_bezier(par, path, jn.curve);
         jn.set(kInf, false, before_mm, Blend::Offset);
@@ -951,6 +956,7 @@ void Planner::close_piece(Piece& p, Piece* next) {
         classify(p, *next, jn);
     else
         jn.set(0, false, 0);
+    if (next) next->start_at_rest = jn.blend == Blend::None && jn.cap_mm_s == 0;
     bool rough = p.rough_start || jn.rough;
     // A Bezier corner, or an offset corner's first piece (its shift, or the turn of a one-sided
     // one moved only after it), starts where the move is cut (evaluated there).

@@ -92,6 +92,7 @@ class Planner {
         std::uint32_t move_id;
         double trim_start_mm = 0;
         bool rough_start = false;  // the junction at its start is not smooth
+        bool start_at_rest = false;  // the tool is at rest where it starts (program start, a stop)
     };
     // Where emit() builds a record. Its bytes are not cleared when the slot is made: an
     // emplace_back() of a PreparedSegment cleared all ~950 of them (GCC: rep stos, also for a
