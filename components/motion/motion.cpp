@@ -658,9 +658,17 @@ class Motion : public hal::Instance {
     // not tripped on.
     void check_joint_motion(double dt, std::int32_t line) noexcept {
         if (!(dt > 0)) return;
+        if (!joints_primed_) {
+            // Before the first period the joints stood where the sampler starts (the planner's
+            // origin), at rest: a move in the very first period counts from there (taking the
+            // first command as the start saw 1.5 times the acceleration in the second period).
+            kins_.kins().inverse(motion::AxisArray{}, joint_prev_mm_);
+            std::fill(joint_vel_mm_s_.begin(), joint_vel_mm_s_.end(), 0.0);
+            joints_primed_ = true;
+        }
         for (std::size_t j = 0; j < joint_count_; ++j) {
-            const double vel = joints_primed_ ? (joint_cmd_mm_[j] - joint_prev_mm_[j]) / dt : 0;
-            const double acc = joints_primed_ ? (vel - joint_vel_mm_s_[j]) / dt : 0;
+            const double vel = (joint_cmd_mm_[j] - joint_prev_mm_[j]) / dt;
+            const double acc = (vel - joint_vel_mm_s_[j]) / dt;
             joint_vel_mm_s_[j] = vel;
             joint_prev_mm_[j] = joint_cmd_mm_[j];
             joint_vel_cmd_[j] = vel;
@@ -669,7 +677,6 @@ class Motion : public hal::Instance {
             note_excess(joint_excess_[j].acc, std::fabs(acc), joint_max_acceleration_[j].get(),
                         line);
         }
-        joints_primed_ = true;
     }
 
     // joint.N.min-limit / max-limit (LinuxCNC's [JOINT_N]MIN_LIMIT / MAX_LIMIT) on the joint
@@ -1181,7 +1188,7 @@ class Motion : public hal::Instance {
     std::vector<double> joint_prev_mm_;  // last period's joint command
     std::vector<double> joint_vel_mm_s_;
     std::vector<JointExcess> joint_excess_;
-    bool joints_primed_ = false;  // joint_prev_mm_ holds a real command
+    bool joints_primed_ = false;   // joint_prev_mm_ and joint_vel_mm_s_ hold the last period's
     bool joints_planned_ = false;  // the planner has the joints' limits (a linear kinematics)
     bool excess_reported_ = false;
     bool enable_now_ = false;      // motion.enable as taken by take_commands() this period
