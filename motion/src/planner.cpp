@@ -597,14 +597,15 @@ double local_time_s(const std::array<Stretch, N>& st, double v_in_mm_s, double v
         v2[i] = std::min(v2[i], v2[i + 1] + 2 * st[i].acc_mm_s2 * st[i].length_mm);
     for (std::size_t i = 0; i < N; ++i)
         v2[i + 1] = std::min(v2[i + 1], v2[i] + 2 * st[i].acc_mm_s2 * st[i].length_mm);
+    std::array<double, N + 1> v;  // each junction's speed, once
+    for (std::size_t i = 0; i <= N; ++i) v[i] = std::sqrt(v2[i]);
     double t = 0;
     for (std::size_t i = 0; i < N; ++i) {
         const double a = st[i].acc_mm_s2, len = st[i].length_mm;
         const double peak2 = std::min(sq(st[i].vcap_mm_s), (2 * a * len + v2[i] + v2[i + 1]) / 2);
         const double peak = std::sqrt(peak2);
         const double ramps_mm = (2 * peak2 - v2[i] - v2[i + 1]) / (2 * a);
-        t += (2 * peak - std::sqrt(v2[i]) - std::sqrt(v2[i + 1])) / a +
-             std::max(0.0, len - ramps_mm) / peak;
+        t += (2 * peak - v[i] - v[i + 1]) / a + std::max(0.0, len - ramps_mm) / peak;
     }
     return t;
 }
@@ -627,19 +628,39 @@ Stretch line_stretch(const AxisArray& t, double x_mm, double feed, const AxisLim
     return st;
 }
 
-// bounds(make_parabola(c, t1, t2, l_mm)) without making it: its hodograph runs straight from
-// t1 to t2 (|p'_k| <= max(|t1_k|, |t2_k|)) and p'' = (t2 - t1) / 2l throughout.
-ElementBounds parabola_bounds(const AxisArray& t1, const AxisArray& t2, double l_mm) {
+// bounds(make_parabola(c, t1, t2, l)) without making it, for any cut l: its hodograph runs
+// straight from t1 to t2 (|p'_k| <= max(|t1_k|, |t2_k|)) and p'' = (t2 - t1) / 2l throughout.
+// Only p'' depends on l, and only in the listed axes (the others have t1_k = t2_k = +-0 there,
+// and so p'' = +0 whatever l): the rest is made once per corner (make_parabola_bounds), p'' for
+// each cut (at).
+struct ParabolaBounds {
     ElementBounds b;
+    AxisArray turn;  // |t2 - t1|
+
+    ElementBounds at(double l_mm) const {
+        ElementBounds out = b;
+        for (int i = 0; i < b.axis_count; ++i) {
+            const int k = b.axes[i];
+            out.g2[k] = turn[k] / (2 * l_mm);
+        }
+        return out;
+    }
+};
+
+// The axes listed are those with max(|t1_k|, |t2_k|) > 0: a turn |t2_k - t1_k| > 0 implies it
+// (unit tangents of lines, finite), so listing those with p' or p'' nonzero lists the same.
+ParabolaBounds make_parabola_bounds(const AxisArray& t1, const AxisArray& t2) {
+    ParabolaBounds pb;
+    ElementBounds& b = pb.b;
     int n = 0;
     for (int k = 0; k < kAxes; ++k) {
         b.g1[k] = b.linear[k] = std::max(std::fabs(t1[k]), std::fabs(t2[k]));
-        b.g2[k] = std::fabs(t2[k] - t1[k]) / (2 * l_mm);
-        b.g3[k] = b.tangential_in_plane[k] = 0;
-        if (b.g1[k] > 0 || b.g2[k] > 0) b.axes[n++] = static_cast<std::uint8_t>(k);
+        pb.turn[k] = std::fabs(t2[k] - t1[k]);
+        b.g2[k] = b.g3[k] = b.tangential_in_plane[k] = 0;
+        if (b.g1[k] > 0) b.axes[n++] = static_cast<std::uint8_t>(k);
     }
     b.axis_count = n;
-    return b;
+    return pb;
 }
 
 // Proved as corner_piece_within, in two pieces split at the parameter u (de Casteljau): a
@@ -702,8 +723,9 @@ bool Planner::one_sided_offset_corner(const Piece& p, const Piece& next, const O
     // line p stands in for it (making one clears and fills 400 bytes a call); the joints' bounds
     // it takes from the element itself (any parabola of that cut: they depend on its shape).
     const LimitShares shares{share, share, 0};
+    const ParabolaBounds parabola_bounds = make_parabola_bounds(t1, t2);
     auto parabola = [&](double l, double centripetal) {
-        const ElementBounds b = parabola_bounds(t1, t2, l);
+        const ElementBounds b = parabola_bounds.at(l);
         LimitShares turning = shares;
         turning.blend_centripetal = centripetal;
         const ElementLimits lim =
@@ -780,9 +802,16 @@ bool Planner::one_sided_offset_corner(const Piece& p, const Piece& next, const O
         }
         Element& shift_e = shift_before ? jn.shift_out : jn.shift_back;
         make_corner_bezier(shift, path, shift_e);
-        const ElementLimits shift_lim =
-            element_limits(shift_e, bounds(shift_e), cfg_.limits, shift_before ? f1 : f2,
-                           {share, share, kShiftCentripetal});
+        // The shift's bounds and limits as add_item() makes them for its Item (bounds(e,
+        // moving) on the axes set_piece_axes() lists: the values bounds(e) gives), kept for
+        // close_piece().
+        const std::span<const int> moving =
+            path.still_at_rest ? std::span<const int>(path.axes.data(), path.dims)
+                               : std::span<const int>();
+        jn.shift_bounds = moving.empty() ? bounds(shift_e) : bounds(shift_e, moving);
+        jn.shift_lim = element_limits(shift_e, jn.shift_bounds, cfg_.limits,
+                                      shift_before ? f1 : f2, {share, share, kShiftCentripetal});
+        const ElementLimits& shift_lim = jn.shift_lim;
         const Stretch shifted{shift_e.length_mm, shift_lim.vcap_mm_s, shift_lim.tangent.acc_mm_s2};
         const Stretch turn = parabola(lp, kIsolatedBlendCentripetal);
         const double t_one_sided = local_time_s(
@@ -984,13 +1013,21 @@ void Planner::close_piece(Piece& p, Piece* next) {
             // and move (a single block stop comes at its end, within the tolerance); off an arc
             // it belongs to the next move, as the turn does, like every blend (synchronised
             // outputs switch where it starts): the move is left where the tool leaves its path.
+            // A one-sided corner (one shift) made its shift's bounds and limits already.
             const Piece& shift_owner = p.geom.kind == ElementKind::Line ? p : *next;
-            if (jn.has_shift_out)
+            const bool one_sided = jn.has_shift_out != jn.has_shift_back;
+            if (jn.has_shift_out && one_sided)
+                add_item_with_limits(jn.shift_out, jn.shift_bounds, jn.shift_lim, shift_owner,
+                                     p.rapid);
+            else if (jn.has_shift_out)
                 add_item(jn.shift_out, p.feed_mm_s, kInf, false, shift_owner, p.rapid,
                          kShiftCentripetal, jn.moving_axes());
             add_item(jn.curve, feed, kInf, false, *next, rapid, kIsolatedBlendCentripetal,
                      jn.moving_axes());
-            if (jn.has_shift_back)
+            if (jn.has_shift_back && one_sided)
+                add_item_with_limits(jn.shift_back, jn.shift_bounds, jn.shift_lim, *next,
+                                     next->rapid);
+            else if (jn.has_shift_back)
                 add_item(jn.shift_back, next->feed_mm_s, kInf, false, *next, next->rapid,
                          kShiftCentripetal, jn.moving_axes());
             next->trim_start_mm = jn.cut_after_mm;
@@ -1026,6 +1063,17 @@ void Planner::add_item(const Element& e, double feed, double end_cap, bool rough
     it.lim = element_limits(e, it.bounds, cfg_.limits, feed, {1 - cut, 1 - cut, blend_centripetal});
     it.end_cap_mm_s = end_cap;
     it.rough = rough;
+    it.line = owner.line;
+    it.move_id = owner.move_id;
+    it.rapid = rapid;
+}
+
+void Planner::add_item_with_limits(const Element& e, const ElementBounds& b,
+                                   const ElementLimits& lim, const Piece& owner, bool rapid) {
+    Item& it = items_.emplace_back(e, b);
+    it.lim = lim;
+    it.end_cap_mm_s = kInf;
+    it.rough = false;
     it.line = owner.line;
     it.move_id = owner.move_id;
     it.rapid = rapid;

@@ -113,6 +113,8 @@ class Planner {
         Item(const Element& e, std::span<const int> moving)
             : geom(element_copy(e)),
               bounds(moving.empty() ? motion::bounds(e) : motion::bounds(e, moving)) {}
+        // With its bounds already known (item_bounds(e, moving) made them).
+        Item(const Element& e, const ElementBounds& b) : geom(element_copy(e)), bounds(b) {}
         Element geom;
         ElementBounds bounds;  // bounds(geom), kept for the rate caps when it is emitted
         ElementLimits lim;
@@ -151,6 +153,10 @@ class Planner {
         std::array<int, kAxes> piece_axes;
         int piece_axis_count = 0;
         bool has_shift_out = true, has_shift_back = true;  // one-sided: only one of them
+        // One-sided: its one shift's Item bounds and limits, as add_item() would make them
+        // (one_sided_offset_corner needs them for its estimate first).
+        ElementBounds shift_bounds;
+        ElementLimits shift_lim;
 
         void set(double cap, bool is_rough, double l_mm, Blend kind = Blend::None) {
             cap_mm_s = cap, rough = is_rough, blend_l_mm = l_mm, blend = kind;
@@ -197,6 +203,11 @@ class Planner {
     // moving: as for Item.
     void add_item(const Element& e, double feed, double end_cap, bool rough, const Piece& owner,
                   bool rapid, double blend_centripetal = 0, std::span<const int> moving = {});
+    // add_item(e, feed, kInf, false, owner, rapid, ...) for an element whose bounds and limits
+    // were already made as add_item() makes them (item_bounds(), then element_limits() with
+    // the shares 1 - reserve_).
+    void add_item_with_limits(const Element& e, const ElementBounds& b, const ElementLimits& lim,
+                              const Piece& owner, bool rapid);
     std::size_t plan_and_emit(bool all);  // returns how many records it emitted
     bool can_join(const Group& g, const Item& it) const;
     void build_groups();
