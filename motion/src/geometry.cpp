@@ -563,11 +563,25 @@ void add_chords(CornerPath& path, const Element& e, double s0, double s1, double
         n = std::clamp(int(std::ceil(want)), 1, CornerPath::kMaxChordsPerMove);
         slack = e.radius_mm * (dphi / n) * (dphi / n) / 8;
     }
+    // Only the path's axes of the points are read. A line's are point_at()'s, worked out
+    // in those axes alone (evaluate_to's clamp, eval_line's expression, the end point at the
+    // end): the chords of the lines beside a corner cost no call.
     auto point = [&](int i, AxisArray& out) {
         double s = i == n ? s1 : s0 + (s1 - s0) * i / n;
-        out = s == known_s ? known : point_at(e, s);
+        if (s == known_s) {
+            out = known;
+        } else if (e.kind == ElementKind::Line) {
+            s = std::clamp(s, 0.0, e.length_mm);
+            const bool at_end = s >= e.length_mm;
+            for (int j = 0; j < path.dims; ++j) {
+                const int k = path.axes[j];
+                out[k] = at_end ? e.end[k] : e.origin[k] + s * e.a[k];
+            }
+        } else {
+            out = point_at(e, s);
+        }
     };
-    AxisArray a, b;
+    AxisArray a{}, b{};  // a line's fill only the path's axes
     point(0, a);
     for (int i = 1; i <= n; ++i, a = b) {
         point(i, b);

@@ -632,18 +632,17 @@ Stretch line_stretch(const AxisArray& t, double x_mm, double feed, const AxisLim
 // straight from t1 to t2 (|p'_k| <= max(|t1_k|, |t2_k|)) and p'' = (t2 - t1) / 2l throughout.
 // Only p'' depends on l, and only in the listed axes (the others have t1_k = t2_k = +-0 there,
 // and so p'' = +0 whatever l): the rest is made once per corner (make_parabola_bounds), p'' for
-// each cut (at).
+// each cut (at, in place: a copy of the 400 bytes per cut was 8 % of the corner's own time).
 struct ParabolaBounds {
     ElementBounds b;
     AxisArray turn;  // |t2 - t1|
 
-    ElementBounds at(double l_mm) const {
-        ElementBounds out = b;
+    const ElementBounds& at(double l_mm) {
         for (int i = 0; i < b.axis_count; ++i) {
             const int k = b.axes[i];
-            out.g2[k] = turn[k] / (2 * l_mm);
+            b.g2[k] = turn[k] / (2 * l_mm);
         }
-        return out;
+        return b;
     }
 };
 
@@ -668,8 +667,13 @@ ParabolaBounds make_parabola_bounds(const AxisArray& t1, const AxisArray& t2) {
 // (each piece's hull near one chord as a whole, corner_part_within), where halving it would
 // split down to the depth limit around u.
 bool split_piece_within(const BezierPoints& b, double u, const CornerPath& path, double limit_mm) {
+    // On a path at rest the proofs read the path's axes only (corner_part_within): the halves
+    // are split there alone, else in every axis.
     BezierPoints first, second;
-    for (int k = 0; k < kAxes; ++k) {
+    const bool at_rest = path.still_at_rest;
+    const int n = at_rest ? path.dims : kAxes;
+    for (int j = 0; j < n; ++j) {
+        const int k = at_rest ? path.axes[j] : j;
         const double p01 = b.p0[k] + u * (b.p1[k] - b.p0[k]);
         const double p12 = b.p1[k] + u * (b.p2[k] - b.p1[k]);
         const double p23 = b.p2[k] + u * (b.p3[k] - b.p2[k]);
@@ -723,9 +727,9 @@ bool Planner::one_sided_offset_corner(const Piece& p, const Piece& next, const O
     // line p stands in for it (making one clears and fills 400 bytes a call); the joints' bounds
     // it takes from the element itself (any parabola of that cut: they depend on its shape).
     const LimitShares shares{share, share, 0};
-    const ParabolaBounds parabola_bounds = make_parabola_bounds(t1, t2);
+    ParabolaBounds parabola_bounds = make_parabola_bounds(t1, t2);
     auto parabola = [&](double l, double centripetal) {
-        const ElementBounds b = parabola_bounds.at(l);
+        const ElementBounds& b = parabola_bounds.at(l);
         LimitShares turning = shares;
         turning.blend_centripetal = centripetal;
         const ElementLimits lim =
