@@ -1,8 +1,8 @@
 // bench_sampler --holds: how soon a hold (or an override step) takes effect with a jerk limit,
 // in the cases docs/benchmarks.md and docs/motion-planner.md quote. 1 ms periods on a simulated
 // clock, so the figures do not depend on the machine or its load. Every period of every run is
-// checked against the axis limits (analytic values and finite differences, as the tests'
-// LimitCheck); a run that leaves them, or a hold that never ends, makes the exit status 1.
+// checked against the axis limits (the tests' LimitCheck, tests/motion/sampler_support.hpp); a
+// run that leaves them, or a hold that never ends, makes the exit status 1.
 #include "holds.hpp"
 
 #include <fmt/format.h>
@@ -14,27 +14,14 @@
 
 #include "motion/planner.hpp"
 #include "motion/sampler.hpp"
+#include "sampler_support.hpp"
 
 namespace sampler_holds {
 namespace {
 
 using namespace motion;
-
-PlannerConfig uniform(double v, double a, double j) {
-    PlannerConfig cfg;
-    cfg.limits.vel_mm_s.fill(v);
-    cfg.limits.acc_mm_s2.fill(a);
-    cfg.limits.jerk_mm_s3.fill(j);
-    return cfg;
-}
-
-PathSegment feed_to(double x, double feed, std::int32_t line) {
-    PathSegment s;
-    s.end_mm = {x};
-    s.feed_mm_s = feed;
-    s.line = line;
-    return s;
-}
+using test::feed_to;
+using test::uniform;
 
 // A full circle of radius_mm about (radius_mm, 0) from the origin, `turns` times.
 PathSegment circle(double radius_mm, int turns, double feed) {
@@ -57,38 +44,6 @@ std::vector<PreparedSegment> plan(const PlannerConfig& cfg, const std::vector<Pa
     while (p.pop(r)) recs.push_back(r);
     return recs;
 }
-
-// Every period within the limits: |v|, |a|, |j| analytic, the acceleration from the sampled
-// positions and the jerk from the sampled accelerations (1e-6 relative, as LimitCheck).
-class Limits {
-  public:
-    explicit Limits(const AxisLimits& lim) : lim_(lim) {}
-    bool ok() const { return ok_; }
-    void operator()(const MotionSample& s, double dt) {
-        const double rel = 1 + 1e-6;
-        for (int k = 0; k < kAxes; ++k) {
-            const double a_fd = n_ >= 2 ? (s.pos_mm[k] - 2 * p1_[k] + p2_[k]) / (dt * dt) : 0;
-            const double j_fd = n_ >= 1 ? (s.acc_mm_s2[k] - a1_[k]) / dt : 0;
-            const double jl = lim_.jerk_mm_s3[k];
-            if (std::fabs(s.vel_mm_s[k]) > lim_.vel_mm_s[k] * rel ||
-                std::fabs(s.acc_mm_s2[k]) > lim_.acc_mm_s2[k] * rel ||
-                std::fabs(a_fd) > lim_.acc_mm_s2[k] * rel + 1e-4 ||
-                (jl > 0 &&
-                 (std::fabs(s.jerk_mm_s3[k]) > jl * rel || std::fabs(j_fd) > jl * rel + 1e-3)))
-                ok_ = false;
-        }
-        p2_ = p1_;
-        p1_ = s.pos_mm;
-        a1_ = s.acc_mm_s2;
-        ++n_;
-    }
-
-  private:
-    AxisLimits lim_;
-    AxisArray p1_{}, p2_{}, a1_{};
-    long n_ = 0;
-    bool ok_ = true;
-};
 
 struct Run {
     // From the request to the first period in which the path decelerates as the jerk limit
@@ -121,7 +76,7 @@ Run play(const PlannerConfig& cfg, const std::vector<PreparedSegment>& recs, lon
     const std::size_t cap = ahead > 0 ? ahead : recs.size();
     SpscRing<PreparedSegment> ring(cap + 1);
     Sampler sampler(sampler_config(cfg), ring, AxisArray{});
-    Limits check(cfg.limits);
+    test::LimitCheck check(cfg.limits);
     std::size_t next = 0;
     MotionSample last{};
     auto step = [&] {

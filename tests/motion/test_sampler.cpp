@@ -11,17 +11,14 @@
 
 #include "motion/planner.hpp"
 #include "motion/sampler.hpp"
+#include "sampler_support.hpp"
 
 namespace motion {
 namespace {
 
-PlannerConfig uniform(double v, double a, double j) {
-    PlannerConfig cfg;
-    cfg.limits.vel_mm_s.fill(v);
-    cfg.limits.acc_mm_s2.fill(a);
-    cfg.limits.jerk_mm_s3.fill(j);
-    return cfg;
-}
+using test::feed_to;
+using test::LimitCheck;
+using test::uniform;
 
 // One long X move at `feed`, planned and loaded into a ring.
 struct Rig {
@@ -179,14 +176,6 @@ void load(SpscRing<PreparedSegment>& ring, const PlannerConfig& cfg,
     while (p.pop(r)) ASSERT_TRUE(ring.try_push(r));
 }
 
-PathSegment feed_to(double x, double feed, std::int32_t line) {
-    PathSegment s;
-    s.end_mm = {x};
-    s.feed_mm_s = feed;
-    s.line = line;
-    return s;
-}
-
 // A fault stop decelerates at the axis limit, jerk or not: from speed v it must be at rest within
 // v^2 / 2a (the ramp) plus one period of travel (the period in which the fault is seen).
 TEST(Sampler, FaultStopEndsWithinTheAccelerationDistance) {
@@ -336,45 +325,6 @@ TEST(Sampler, EmptyRingHoldsTheStartPosition) {
 }
 
 // ---- jerk-limited rate changes (the room-based r' and r'' bounds) -----------------------------
-
-// Every period: analytic velocity, acceleration and jerk, and the finite differences of the
-// sampled position (acceleration) and acceleration (jerk), within the limits (1e-6 relative).
-class LimitCheck {
-  public:
-    explicit LimitCheck(const AxisLimits& lim) : lim_(lim) {}
-    // Empty, or the first problem seen.
-    const std::string& first() const { return first_; }
-    void operator()(const MotionSample& s, double dt) {
-        const double rel = 1 + 1e-6;
-        for (int k = 0; k < kAxes && first_.empty(); ++k) {
-            const double a_fd = n_ >= 2 ? (s.pos_mm[k] - 2 * p1_[k] + p2_[k]) / (dt * dt) : 0;
-            const double j_fd = n_ >= 1 ? (s.acc_mm_s2[k] - a1_[k]) / dt : 0;
-            const bool jerk = lim_.jerk_mm_s3[k] > 0;
-            const char* what = std::fabs(s.vel_mm_s[k]) > lim_.vel_mm_s[k] * rel ? "velocity"
-                               : std::fabs(s.acc_mm_s2[k]) > lim_.acc_mm_s2[k] * rel ? "acceleration"
-                               : std::fabs(a_fd) > lim_.acc_mm_s2[k] * rel + 1e-4 ? "sampled acceleration"
-                               : jerk && std::fabs(s.jerk_mm_s3[k]) > lim_.jerk_mm_s3[k] * rel
-                                   ? "jerk"
-                               : jerk && std::fabs(j_fd) > lim_.jerk_mm_s3[k] * rel + 1e-3
-                                   ? "sampled jerk"
-                                   : nullptr;
-            if (what)
-                first_ = "period " + std::to_string(n_) + " axis " + std::to_string(k) + ": " + what +
-                         " (a " + std::to_string(s.acc_mm_s2[k]) + ", j " +
-                         std::to_string(s.jerk_mm_s3[k]) + ", j_fd " + std::to_string(j_fd) + ")";
-        }
-        p2_ = p1_;
-        p1_ = s.pos_mm;
-        a1_ = s.acc_mm_s2;
-        ++n_;
-    }
-
-  private:
-    AxisLimits lim_;
-    AxisArray p1_{}, p2_{}, a1_{};
-    long n_ = 0;
-    std::string first_;
-};
 
 PathSegment arc_to(AxisArray end, std::array<double, 2> centre, double feed, std::int32_t line) {
     PathSegment s = feed_to(0, feed, line);
