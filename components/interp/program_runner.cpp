@@ -101,7 +101,6 @@ std::string ProgramRunner::error() const {
     return error_;
 }
 
-
 bool ProgramRunner::stopping() noexcept {
     if (link_.abort_requested()) abort_.store(true, std::memory_order_relaxed);
     return worker_.pause_requested() || abort_.load(std::memory_order_relaxed);
