@@ -218,9 +218,10 @@ TEST(CncRunSettings, FailedSaveIsAnErrorOfTheBlockAndKeepsTheOldFile) {
     expect_next_run_ends_at(m, "G90 G21\nG0 X0 Y0\nM30\n", 10, 20, 0);
 }
 
-// Two runs on the same settings at once: the second is refused before it runs a block, naming
-// the file and the first's process id, and its change is not saved. This test process holds
-// the lock, as a first run would (interp::SettingsFileLock, the lock every run takes).
+// Two runs on the same settings at once: the second is refused before HAL loads (exit 2, a
+// configuration error), naming the file and the first's process id, and its change is not
+// saved. This test process holds the lock, as a first run would (interp::SettingsFileLock, the
+// lock every run takes).
 TEST(CncRunSettings, ASecondRunOnTheSameSettingsIsRefused) {
     const Machine m;
     ASSERT_EQ(m.run("set.ngc", "G90 G21\nG922 P0 X10\nM30\n").exit_code, 0);
@@ -228,7 +229,8 @@ TEST(CncRunSettings, ASecondRunOnTheSameSettingsIsRefused) {
     for (const std::string name : {"mill.var", "sim.tbl"}) {
         const interp::SettingsFileLock held(m.file(name).string());
         const RunResult r = m.run("change.ngc", "G90 G21\nG922 P0 X20\nG923 P1 Z30\nM30\n");
-        EXPECT_EQ(r.exit_code, 1) << r.out;
+        EXPECT_EQ(r.exit_code, 2) << r.out;
+        EXPECT_EQ(r.out.find("clock:"), std::string::npos) << r.out;  // no machine was started
         EXPECT_NE(r.err.find(fmt::format("{}: settings file in use by another run (pid {}); two "
                                          "runs on the same settings would overwrite each "
                                          "other's changes",

@@ -44,6 +44,7 @@
 #include "hal/script.hpp"
 #include "interp/block.hpp"
 #include "interp/canon_wire.hpp"
+#include "interp/persist.hpp"
 #include "preview.hpp"
 #include "ring.hpp"
 #include "runtime.hpp"
@@ -170,6 +171,21 @@ int count_lines(const std::string& path) {
     return lines;
 }
 
+// Another run holding this machine's settings file or tool table would refuse this one only
+// after HAL has loaded (the interp component takes the locks when it loads, exit 1). Asked
+// here first, the refusal is a configuration error (exit 2) before anything loads or moves;
+// the component's own lock stays the guard against a run that starts in between.
+void refuse_state_files_in_use(const machine_program::StateFiles& files) {
+    for (const std::string* path : {&files.settings, &files.tool_table}) {
+        if (path->empty()) continue;
+        try {
+            const interp::SettingsFileLock probe(*path);
+        } catch (const std::runtime_error& e) {
+            throw hal::Error(e.what());
+        }
+    }
+}
+
 Config load_config(const RunOptions& o) {
     const hal::IniFile ini = hal::IniFile::load(o.ini);
     Config c;
@@ -191,8 +207,9 @@ Config load_config(const RunOptions& o) {
     c.program_lines = count_lines(o.program);
     // The components read [RS274NGC] and the state files again (ini=$(INI_FILE_NAME)); a bad
     // value or settings line is reported here first, as its file:line, before anything loads.
-    c.dialect = machine_program::read_ini(ini, o.settings_dir).dialect;
-    if (c.dialect.empty()) c.dialect = "ncstudio";
+    const machine_program::Options options = machine_program::read_ini(ini, o.settings_dir);
+    refuse_state_files_in_use(options.state);
+    c.dialect = options.dialect.empty() ? "ncstudio" : options.dialect;
     return c;
 }
 
