@@ -184,8 +184,7 @@ void ProgramRunner::fail_with(const interp::Error& e) {
 void ProgramRunner::give_up(std::string_view why) {
     const std::string cause = fmt::format("{}; the rest of the program is given up", why);
     if (last_loc_.line == 0) return finish(fmt::format("{}: {}", cfg_.program_path, cause));
-    finish(fmt::format("{}:{}:{}: {}", last_loc_.file, last_loc_.line, last_loc_.col, cause),
-           &last_loc_, cause);
+    fail_with(interp::Error(last_loc_, cause));  // its what() is the place and the cause
 }
 
 void ProgramRunner::open_program() {
