@@ -2,7 +2,7 @@
 // persistent parameters in [RS274NGC]PARAMETER_FILE, tool lengths in [EMCIO]TOOL_TABLE. Each
 // test keeps them in its own scratch folder (--settings-dir), so tests run in parallel and
 // never write into configs/sim. Positions are checked by hand from configs/sim/mill.ini
-// (X 0..400, Y 0..300, Z -100..0), configs/sim/sim.tbl (T1 Z40, T2 Z35) and the programs.
+// (X 0..400, Y 0..300, Z -100..0), configs/sim/mill.tbl (T1 Z40, T2 Z35) and the programs.
 // NcStudio writes work offsets with G922 P<n> (P0 = G54) and tool lengths with G923; ISO's
 // G10 L2 is not implemented by the interpreter. A hand-written tool table keeps its lines and
 // words; a second run on the same files at once is refused.
@@ -98,27 +98,27 @@ TEST(CncRunSettings, PersistentParameterWrittenInOneRunIsReadInTheNext) {
 
 TEST(CncRunSettings, ToolLengthComesFromTheTable) {
     const Machine m;
-    // why: T1 is 40 mm long in sim.tbl; under G43 H1 programmed Z-60 is machine Z-60+40 = -20.
+    // why: T1 is 40 mm long in mill.tbl; under G43 H1 programmed Z-60 is machine Z-60+40 = -20.
     const RunResult r = m.run("tool.ngc", "G90 G21\nT1 M6\nG43 H1 G0 Z-60\nM30\n");
     ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
     expect_xyz(r, 0, 0, -20);
     // Nothing changed, so nothing was written.
-    EXPECT_FALSE(fs::exists(m.file("sim.tbl")));
+    EXPECT_FALSE(fs::exists(m.file("mill.tbl")));
     EXPECT_FALSE(fs::exists(m.file("mill.var")));
 }
 
 TEST(CncRunSettings, ToolLengthWrittenInOneRunIsUsedInTheNextAndTheShippedTableStays) {
-    const std::string shipped = slurp(kSimDir / "sim.tbl");
+    const std::string shipped = slurp(kSimDir / "mill.tbl");
     const Machine m;
     const RunResult set = m.run("set.ngc", "G90 G21\nG923 P1 Z30\nM30\n");
     ASSERT_EQ(set.exit_code, 0) << set.err << set.out;
     // The shipped table with T1's Z40 changed to Z30 and nothing else.
-    EXPECT_EQ(slurp(m.file("sim.tbl")),
+    EXPECT_EQ(slurp(m.file("mill.tbl")),
               "T1 P1 D6 Z30 ;6 mm flat end mill\n"
               "T2 P2 D3 Z35 ;3 mm flat end mill\n"
               "T3 P3 D6 Z45 ;6 mm ball end mill\n"
               "T4 P4 D10 Z50 ;10 mm drill\n");
-    EXPECT_EQ(slurp(kSimDir / "sim.tbl"), shipped);
+    EXPECT_EQ(slurp(kSimDir / "mill.tbl"), shipped);
     // The settings file holds no tools while a tool table is kept.
     EXPECT_EQ(slurp(m.file("mill.var")).find("tool "), std::string::npos);
     // why: Z-60 + 30 = -30.
@@ -137,10 +137,10 @@ TEST(CncRunSettings, AHandWrittenToolTableKeepsEverythingButTheChangedValue) {
         "\n"
         "T2 P2 D3.000 Z35.000 Q2   ;  3 mm flat end mill\n"
         "t1 p1 d6 z+40 ;lower case\n";
-    std::ofstream(m.file("sim.tbl")) << hand;
+    std::ofstream(m.file("mill.tbl")) << hand;
     const RunResult set = m.run("set.ngc", "G90 G21\nG923 P2 Z36.25\nG923 P9 Z12\nM30\n");
     ASSERT_EQ(set.exit_code, 0) << set.err << set.out;
-    EXPECT_EQ(slurp(m.file("sim.tbl")),
+    EXPECT_EQ(slurp(m.file("mill.tbl")),
               "; mill 3, tools measured 2026-11-02\n"
               ";T P  X Y Z   A B C U V W D  I J Q\n"
               "T4 P4 X0 Y0 Z50 A0 B0 C0 U0 V0 W0 D10 I0 J0 Q0 ;10 mm drill\n"
@@ -191,11 +191,11 @@ TEST(CncRunSettings, BadSettingsLineRefusesToStart) {
 TEST(CncRunSettings, BadToolTableLineRefusesToStart) {
     const Machine m;
     fs::create_directories(m.settings_dir());
-    std::ofstream(m.file("sim.tbl")) << "T1 P1 Z40 D6\nT2 P2 Zx D3\n";
+    std::ofstream(m.file("mill.tbl")) << "T1 P1 Z40 D6\nT2 P2 Zx D3\n";
     const RunResult r = m.run("use.ngc", "G90 G21\nG0 X5\nM30\n");
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_EQ(r.err, fmt::format("{}:2:8: tool table: expected a number after 'Z'\n",
-                                 m.file("sim.tbl").string()));
+                                 m.file("mill.tbl").string()));
 }
 
 // A directory where the save's temporary file goes makes the save fail even for root.
@@ -226,7 +226,7 @@ TEST(CncRunSettings, ASecondRunOnTheSameSettingsIsRefused) {
     const Machine m;
     ASSERT_EQ(m.run("set.ngc", "G90 G21\nG922 P0 X10\nM30\n").exit_code, 0);
     const std::string before = slurp(m.file("mill.var"));
-    for (const std::string name : {"mill.var", "sim.tbl"}) {
+    for (const std::string name : {"mill.var", "mill.tbl"}) {
         const interp::SettingsFileLock held(m.file(name).string());
         const RunResult r = m.run("change.ngc", "G90 G21\nG922 P0 X20\nG923 P1 Z30\nM30\n");
         EXPECT_EQ(r.exit_code, 2) << r.out;
@@ -238,7 +238,7 @@ TEST(CncRunSettings, ASecondRunOnTheSameSettingsIsRefused) {
                   std::string::npos)
             << r.err;
         EXPECT_EQ(slurp(m.file("mill.var")), before);
-        EXPECT_FALSE(fs::exists(m.file("sim.tbl")));
+        EXPECT_FALSE(fs::exists(m.file("mill.tbl")));
     }
     // Once the first run has let go the next one runs: G54 at X20, so work X0 is machine X20.
     ASSERT_EQ(m.run("change.ngc", "G90 G21\nG922 P0 X20\nG0 X0\nM30\n").exit_code, 0);
@@ -281,7 +281,7 @@ TEST(CncRunSettings, WithoutAToolTableTheToolsAreInTheSettingsFile) {
     ASSERT_EQ(run("set.ngc", "G90 G21\nG923 P5 Z22\nM30\n").exit_code, 0);
     const fs::path settings = scratch.path() / "settings/mill.var";
     EXPECT_NE(slurp(settings).find("\ntool 5 0 0 22 0\n"), std::string::npos) << slurp(settings);
-    EXPECT_FALSE(fs::exists(scratch.path() / "settings/sim.tbl"));
+    EXPECT_FALSE(fs::exists(scratch.path() / "settings/mill.tbl"));
     // why: T5 is 22 mm long; Z-60 under G43 H5 is machine Z-38.
     const RunResult use = run("use.ngc", "G90 G21\nT5 M6\nG43 H5 G0 Z-60\nM30\n");
     ASSERT_EQ(use.exit_code, 0) << use.err << use.out;

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <string>
 
 #include "hal/ini.hpp"
@@ -186,6 +187,28 @@ TEST_F(Folder, AnOffsetSaveKeepsAToolOnlyTheSettingsFileLists) {
     s.tools.at(1).offset_mm[2] = 41;
     saver.save(s);
     EXPECT_EQ(cnc_test::slurp(f.tool_table), "T1 P1 Z41 D6\nT2 P2 Z22 D0\n");
+}
+
+// Two of the stock sim machines can run at once without a settings folder: a run locks its
+// settings file and tool table, so any file two of them shared would keep the second out.
+TEST(MachineStateFiles, EveryStockSimMachineKeepsItsOwnFiles) {
+    std::set<std::string> seen;
+    int machines = 0;
+    for (const fs::directory_entry& e :
+         fs::directory_iterator(fs::path(CNC_SOURCE_DIR) / "configs/sim")) {
+        if (e.path().extension() != ".ini") continue;
+        ++machines;
+        const StateFiles f =
+            machine_program::state_files(hal::IniFile::load(e.path().string()));
+        ASSERT_FALSE(f.settings.empty()) << e.path();
+        ASSERT_FALSE(f.tool_table.empty()) << e.path();
+        EXPECT_TRUE(fs::exists(f.tool_table)) << e.path() << " names " << f.tool_table;
+        EXPECT_TRUE(seen.insert(fs::weakly_canonical(f.settings).string()).second)
+            << e.path() << " shares " << f.settings;
+        EXPECT_TRUE(seen.insert(fs::weakly_canonical(f.tool_table).string()).second)
+            << e.path() << " shares " << f.tool_table;
+    }
+    EXPECT_GE(machines, 5);
 }
 
 }  // namespace
