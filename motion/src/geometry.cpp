@@ -239,13 +239,12 @@ ElementBounds bounds(const Element& e) noexcept {
     return b;
 }
 
-ElementBounds bounds(const Element& e, std::span<const int> moving) noexcept {
-    ElementBounds b;  // one object on every path, built where the caller wants it
+void bounds_into(const Element& e, std::span<const int> moving, ElementBounds& b) noexcept {
     const BezierFactors f = bezier_factors(e);
     if (e.kind != ElementKind::Bezier ||
         !(std::isfinite(f.s1) && std::isfinite(f.s2) && std::isfinite(f.s3))) {
         bounds_into(e, b);
-        return b;
+        return;
     }
     // Whole arrays (vector stores; a loop would become rep stos, see the lines above).
     b.g1 = {};
@@ -255,19 +254,25 @@ ElementBounds bounds(const Element& e, std::span<const int> moving) noexcept {
     b.linear = {};
     for (int k : moving) bezier_axis_bounds(e, k, f, b);
     list_moving_axes(b, ListedAxes{moving.data(), static_cast<int>(moving.size())});
+}
+
+ElementBounds bounds(const Element& e, std::span<const int> moving) noexcept {
+    ElementBounds b;  // one object on every path, built where the caller wants it
+    bounds_into(e, moving, b);
     return b;
 }
 
+// The Elements here are built with every member given, the zero arrays as copies of a
+// variable: `Element e;` and member stores cleared all 400 bytes first (its default member
+// initialisers), and so did an aggregate with `AxisArray{}` members (GCC clears a whole object
+// before its initialiser when that has enough zeros), both with rep stos, whose start-up cost
+// more than the stores (a quarter of make_line's time on tp_default).
 Element make_line(const AxisArray& start, const AxisArray& end) noexcept {
-    Element e;
-    e.kind = ElementKind::Line;
-    AxisArray d;
+    AxisArray d, a, zero{};
     for (int k = 0; k < kAxes; ++k) d[k] = end[k] - start[k];
-    e.length_mm = norm(d);
-    e.origin = start;
-    e.end = end;
-    for (int k = 0; k < kAxes; ++k) e.a[k] = e.length_mm > 0 ? d[k] / e.length_mm : 0;
-    return e;
+    const double length = norm(d);
+    for (int k = 0; k < kAxes; ++k) a[k] = length > 0 ? d[k] / length : 0;
+    return Element{ElementKind::Line, length, start, a, zero, zero, end, 0, 0, 0};
 }
 
 Element make_arc(const AxisArray& start, const PathSegment& seg) {
@@ -328,16 +333,14 @@ Element make_arc(const AxisArray& start, const PathSegment& seg) {
 
 Element make_blend(const AxisArray& corner, const AxisArray& t1, const AxisArray& t2,
                    double l) noexcept {
-    Element e;
-    e.kind = ElementKind::Blend;
-    e.length_mm = 2 * l;
+    AxisArray origin, a, b, end, zero{};  // zero: see make_line
     for (int k = 0; k < kAxes; ++k) {
-        e.origin[k] = corner[k] - l * t1[k];
-        e.a[k] = t1[k];
-        e.b[k] = t2[k] - t1[k];
-        e.end[k] = corner[k] + l * t2[k];
+        origin[k] = corner[k] - l * t1[k];
+        a[k] = t1[k];
+        b[k] = t2[k] - t1[k];
+        end[k] = corner[k] + l * t2[k];
     }
-    return e;
+    return Element{ElementKind::Blend, 2 * l, origin, a, b, zero, end, 0, 0, 0};
 }
 
 namespace {
@@ -361,14 +364,9 @@ double bezier_length_in(const AxisArray& p0, const AxisArray& p1, const AxisArra
 
 Element make_bezier(const AxisArray& p0, const AxisArray& p1, const AxisArray& p2,
                     const AxisArray& p3) noexcept {
-    Element e;
-    e.kind = ElementKind::Bezier;
-    e.origin = p0;
-    e.a = p1;
-    e.b = p2;
-    e.end = p3;
-    e.length_mm = bezier_length_in(p0, p1, p2, p3, AllAxes{});
-    return e;
+    AxisArray zero{};  // see make_line
+    return Element{ElementKind::Bezier, bezier_length_in(p0, p1, p2, p3, AllAxes{}), p0, p1, p2,
+                   zero,                 p3, 0, 0, 0};
 }
 
 void make_corner_bezier(const BezierPoints& b, const CornerPath& path, Element& out) noexcept {
@@ -439,14 +437,19 @@ EndDerivs end_derivs(const Element& e, bool with_d2) noexcept {
 }
 
 Element trim_line(const Element& line, double from, double to) noexcept {
-    Element e = line;
-    double len = line.length_mm;
-    for (int k = 0; k < kAxes; ++k) {
-        e.origin[k] = line.origin[k] + from * line.a[k];
-        if (to > 0) e.end[k] = line.end[k] - to * line.a[k];
-    }
-    e.length_mm = std::max(0.0, len - from - to);
-    return e;
+    // Built with every member given (see make_line): `Element e = line;` copied all 400 bytes
+    // with rep movs, half of this function's time, before most were written again.
+    AxisArray origin, end;
+    for (int k = 0; k < kAxes; ++k) origin[k] = line.origin[k] + from * line.a[k];
+    if (to > 0)
+        for (int k = 0; k < kAxes; ++k) end[k] = line.end[k] - to * line.a[k];
+    else
+        end = line.end;
+    return Element{line.kind, std::max(0.0, line.length_mm - from - to),
+                   origin,    line.a,
+                   line.b,    line.c,
+                   end,       line.radius_mm,
+                   line.theta0_rad, line.sweep_rad};
 }
 
 namespace {

@@ -350,7 +350,7 @@ double max_trim_mm(const Element& e, double trimmed_start_mm) {
 // arc_end_mm: where an arc ends once trimmed, if already known (see trim_arc).
 Element trimmed(const Element& e, double from_mm, double to_mm,
                 const AxisArray* arc_end_mm = nullptr) {
-    if (from_mm <= 0 && to_mm <= 0) return e;
+    if (from_mm <= 0 && to_mm <= 0) return element_copy(e);  // `return e` copied with rep movs
     return e.kind == ElementKind::Line ? trim_line(e, from_mm, to_mm)
                                        : trim_arc(e, from_mm, to_mm, arc_end_mm);
 }
@@ -651,11 +651,15 @@ struct ParabolaBounds {
 ParabolaBounds make_parabola_bounds(const AxisArray& t1, const AxisArray& t2) {
     ParabolaBounds pb;
     ElementBounds& b = pb.b;
+    // The zeros as whole arrays: stored in the loop they became one rep stos, whose start-up
+    // cost more than the stores.
+    b.g2 = {};
+    b.g3 = {};
+    b.tangential_in_plane = {};
     int n = 0;
     for (int k = 0; k < kAxes; ++k) {
         b.g1[k] = b.linear[k] = std::max(std::fabs(t1[k]), std::fabs(t2[k]));
         pb.turn[k] = std::fabs(t2[k] - t1[k]);
-        b.g2[k] = b.g3[k] = b.tangential_in_plane[k] = 0;
         if (b.g1[k] > 0) b.axes[n++] = static_cast<std::uint8_t>(k);
     }
     b.axis_count = n;
@@ -812,7 +816,11 @@ bool Planner::one_sided_offset_corner(const Piece& p, const Piece& next, const O
         const std::span<const int> moving =
             path.still_at_rest ? std::span<const int>(path.axes.data(), path.dims)
                                : std::span<const int>();
-        jn.shift_bounds = moving.empty() ? bounds(shift_e) : bounds(shift_e, moving);
+        // Written in place: assigning bounds()'s value copied it once more (rep movs).
+        if (moving.empty())
+            jn.shift_bounds = bounds(shift_e);
+        else
+            bounds_into(shift_e, moving, jn.shift_bounds);
         jn.shift_lim = element_limits(shift_e, jn.shift_bounds, cfg_.limits,
                                       shift_before ? f1 : f2, {share, share, kShiftCentripetal});
         const ElementLimits& shift_lim = jn.shift_lim;

@@ -105,6 +105,16 @@ ElementBounds bounds(const Element& e) noexcept;
 // other element, and a Bezier whose factors (powers of 1 / length) are not finite, get
 // bounds(e). For the planner, whose corner pieces move in 2 or 3 of the 9 axes.
 ElementBounds bounds(const Element& e, std::span<const int> moving) noexcept;
+// The same written into `out`, for a caller that keeps the bounds in a larger object: assigning
+// the value bounds() returns copies its 376 bytes once more (GCC: rep movs, whose start-up costs
+// more than the copy).
+void bounds_into(const Element& e, std::span<const int> moving, ElementBounds& out) noexcept;
+// A copy of b, member by member (as element_copy, for the same reason).
+static_assert(sizeof(ElementBounds) == 5 * sizeof(AxisArray) + 16,
+              "bounds_copy copies every member of ElementBounds: add new ones there");
+inline ElementBounds bounds_copy(const ElementBounds& b) noexcept {
+    return ElementBounds{b.g1, b.g2, b.g3, b.tangential_in_plane, b.linear, b.axes, b.axis_count};
+}
 
 Element make_line(const AxisArray& start, const AxisArray& end) noexcept;
 // Throws PlanError for a zero radius, an end off the circle, a bad plane or zero turns.

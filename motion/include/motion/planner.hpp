@@ -114,7 +114,8 @@ class Planner {
             : geom(element_copy(e)),
               bounds(moving.empty() ? motion::bounds(e) : motion::bounds(e, moving)) {}
         // With its bounds already known (item_bounds(e, moving) made them).
-        Item(const Element& e, const ElementBounds& b) : geom(element_copy(e)), bounds(b) {}
+        Item(const Element& e, const ElementBounds& b)
+            : geom(element_copy(e)), bounds(bounds_copy(b)) {}
         Element geom;
         ElementBounds bounds;  // bounds(geom), kept for the rate caps when it is emitted
         ElementLimits lim;
