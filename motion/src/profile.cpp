@@ -43,10 +43,10 @@ class PhaseWriter {
         double dv = v1 - v0;
         if (dv == 0) return;
         double sign = dv > 0 ? 1.0 : -1.0;
-        push(sign * a, 0, t_s);
+        push_without_jerk(sign * a, t_s);
     }
 
-    void cruise(double duration) { push(0, 0, duration); }
+    void cruise(double duration) { push_without_jerk(0, duration); }
 
     void start(double v) { v_ = v; }
 
@@ -65,6 +65,23 @@ class PhaseWriter {
         t_ += dt;
         p_.peak_a_mm_s2 = std::max({p_.peak_a_mm_s2, std::fabs(a0), std::fabs(a_)});
         p_.peak_j_mm_s3 = std::max(p_.peak_j_mm_s3, std::fabs(j));
+    }
+
+    // push(a0, 0, dt), the trapezoids' phases: with j = +0 each jerk term (j dt^3 / 6,
+    // j dt^2 / 2, j dt) is +0 for a finite dt and NaN otherwise (dt > 0 or NaN here), as 0 * dt
+    // is. So one product stands for them, with the sums in the same order: the same values,
+    // without three products and a division per term (the division by 6 was on every phase).
+    void push_without_jerk(double a0, double dt) {
+        if (dt <= 0) return;
+        ProfilePhase& ph = p_.phases[p_.count++];
+        ph = {t_, s_, v_, a0, 0};
+        const double jerk_terms = 0 * dt;
+        s_ += v_ * dt + a0 * dt * dt / 2 + jerk_terms;
+        v_ += a0 * dt + jerk_terms;
+        a_ = a0 + jerk_terms;
+        t_ += dt;
+        p_.peak_a_mm_s2 = std::max({p_.peak_a_mm_s2, std::fabs(a0), std::fabs(a_)});
+        p_.peak_j_mm_s3 = std::max(p_.peak_j_mm_s3, 0.0);
     }
 
     Profile1D& p_;
