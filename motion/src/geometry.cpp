@@ -417,6 +417,9 @@ Element trim_arc(const Element& arc, double from, double to, const AxisArray* en
 namespace {
 
 EndDerivs derivs_at(const Element& e, double s, bool with_d2) {
+    // A line's tangent is its direction and its p'' is +0 (eval_line), wherever s is: the
+    // point, which is not needed here, was most of the cost (classify() asks at every junction).
+    if (e.kind == ElementKind::Line) return {e.a, AxisArray{}};
     CurvePoint cp;
     if (with_d2) {
         evaluate_to<2>(e, s, cp);
