@@ -20,6 +20,7 @@ packages=(
   procps
   libcairo2-dev
   libexpat1-dev
+  python3-scipy
 )
 missing=()
 for p in "${packages[@]}"; do
