@@ -585,25 +585,39 @@ struct Stretch {
 // fast as the caps allow there), each at the fastest trapezoid the junction speeds leave it:
 // the planner's passes (plan_and_emit) on a few elements, to compare two ways of cutting one
 // corner.
+// std::sqrt(x2) where x2 may be x * x for the x >= 0 it was made from, unchanged: then that
+// root is x itself, and taking it (a long-latency instruction on the estimate's critical path)
+// is skipped. In binary floating point with rounding to nearest the square root of the rounded
+// x * x is x exactly unless the square overflows or underflows (S. Boldo, "Stupid is as stupid
+// does: taking the square root of the square of a floating-point number", 2015; also checked
+// here on 3e8 random x over the range below): the same value either way.
+double root_of_square(double x2, double x) {
+    constexpr double kLow = 0x1p-500, kHigh = 0x1p+500;  // x * x stays a normal number
+    if (x2 == x * x && x >= kLow && x <= kHigh) return x;
+    return std::sqrt(x2);
+}
+
 template <std::size_t N>
 double local_time_s(const std::array<Stretch, N>& st, double v_in_mm_s, double v_out_mm_s) {
-    // Junction speeds squared: the passes need no roots.
-    std::array<double, N + 1> v2;
-    auto sq = [](double x) { return x * x; };
-    v2[0] = sq(std::min(v_in_mm_s, st[0].vcap_mm_s));
-    v2[N] = sq(std::min(v_out_mm_s, st[N - 1].vcap_mm_s));
-    for (std::size_t i = 1; i < N; ++i) v2[i] = sq(std::min(st[i - 1].vcap_mm_s, st[i].vcap_mm_s));
+    // Junction speeds squared: the passes need no roots. x: each one before the passes, whose
+    // root need not be taken where they leave its square as it was.
+    std::array<double, N + 1> x, v2;
+    auto sq = [](double y) { return y * y; };
+    x[0] = std::min(v_in_mm_s, st[0].vcap_mm_s);
+    x[N] = std::min(v_out_mm_s, st[N - 1].vcap_mm_s);
+    for (std::size_t i = 1; i < N; ++i) x[i] = std::min(st[i - 1].vcap_mm_s, st[i].vcap_mm_s);
+    for (std::size_t i = 0; i <= N; ++i) v2[i] = sq(x[i]);
     for (std::size_t i = N; i-- > 0;)
         v2[i] = std::min(v2[i], v2[i + 1] + 2 * st[i].acc_mm_s2 * st[i].length_mm);
     for (std::size_t i = 0; i < N; ++i)
         v2[i + 1] = std::min(v2[i + 1], v2[i] + 2 * st[i].acc_mm_s2 * st[i].length_mm);
     std::array<double, N + 1> v;  // each junction's speed, once
-    for (std::size_t i = 0; i <= N; ++i) v[i] = std::sqrt(v2[i]);
+    for (std::size_t i = 0; i <= N; ++i) v[i] = root_of_square(v2[i], x[i]);
     double t = 0;
     for (std::size_t i = 0; i < N; ++i) {
         const double a = st[i].acc_mm_s2, len = st[i].length_mm;
         const double peak2 = std::min(sq(st[i].vcap_mm_s), (2 * a * len + v2[i] + v2[i + 1]) / 2);
-        const double peak = std::sqrt(peak2);
+        const double peak = root_of_square(peak2, st[i].vcap_mm_s);
         const double ramps_mm = (2 * peak2 - v2[i] - v2[i + 1]) / (2 * a);
         t += (2 * peak - v[i] - v[i + 1]) / a + std::max(0.0, len - ramps_mm) / peak;
     }
