@@ -1005,6 +1005,18 @@ bool Planner::offset_arc_corner(const Piece& p, const Piece& next, double sin_an
     return false;
 }
 
+template <class MakeElement>
+double Planner::add_item_made(MakeElement&& make, double feed, double end_cap, bool rough,
+                              const Piece& owner, bool rapid) {
+    Item& it = items_.emplace_back(Item::Made{}, std::forward<MakeElement>(make));
+    const double length_mm = it.geom.length_mm;
+    if (length_mm > kMinLength_mm)
+        set_item_limits(it, feed, end_cap, rough, owner, rapid, 0);
+    else
+        items_.pop_back();  // vanished (its bounds were made for nothing; rare)
+    return length_mm;
+}
+
 void Planner::close_piece(Piece& p, Piece* next) {
     Junction& jn = junction_;
     if (next)
@@ -1019,9 +1031,10 @@ void Planner::close_piece(Piece& p, Piece* next) {
     if (jn.blend == Blend::Curve) blend_start = &jn.curve.origin;
     if (jn.blend == Blend::Offset)
         blend_start = jn.has_shift_out ? &jn.shift_out.origin : &jn.curve.origin;
-    Element e = trimmed(p.geom, p.trim_start_mm, jn.blend_l_mm, blend_start);
     // Only a line blended at both ends can vanish, and its junctions are smooth.
-    if (e.length_mm > kMinLength_mm) add_item(e, p.feed_mm_s, jn.cap_mm_s, rough, p, p.rapid);
+    const double e_length_mm = add_item_made(
+        [&] { return trimmed(p.geom, p.trim_start_mm, jn.blend_l_mm, blend_start); },
+        p.feed_mm_s, jn.cap_mm_s, rough, p, p.rapid);
     if (!next) return;
     double f1 = p.feed_mm_s, f2 = next->feed_mm_s;
     double feed = f1 > 0 && f2 > 0 ? std::min(f1, f2) : std::max(f1, f2);
@@ -1031,7 +1044,7 @@ void Planner::close_piece(Piece& p, Piece* next) {
     // a jerk limit nearly all its acceleration goes to turning. In a chain of short moves the
     // blends must change speed themselves and keep the default share.
     double l = jn.blend_l_mm;
-    bool isolated = !jerk_mode_ && l > 0 && e.length_mm >= l && next->geom.length_mm / 2 >= 2 * l;
+    bool isolated = !jerk_mode_ && l > 0 && e_length_mm >= l && next->geom.length_mm / 2 >= 2 * l;
     double turning = isolated ? kIsolatedBlendCentripetal : 0;
     switch (jn.blend) {
         case Blend::Offset: {
@@ -1084,9 +1097,15 @@ void Planner::close_piece(Piece& p, Piece* next) {
 void Planner::add_item(const Element& e, double feed, double end_cap, bool rough,
                        const Piece& owner, bool rapid, double blend_centripetal,
                        std::span<const int> moving) {
-    Item& it = items_.emplace_back(e, moving);
+    set_item_limits(items_.emplace_back(e, moving), feed, end_cap, rough, owner, rapid,
+                    blend_centripetal);
+}
+
+void Planner::set_item_limits(Item& it, double feed, double end_cap, bool rough,
+                              const Piece& owner, bool rapid, double blend_centripetal) {
     double cut = reserve_ + (rough ? cfg_.junction_share : 0);
-    it.lim = element_limits(e, it.bounds, cfg_.limits, feed, {1 - cut, 1 - cut, blend_centripetal});
+    it.lim = element_limits(it.geom, it.bounds, cfg_.limits, feed,
+                            {1 - cut, 1 - cut, blend_centripetal});
     it.end_cap_mm_s = end_cap;
     it.rough = rough;
     it.line = owner.line;

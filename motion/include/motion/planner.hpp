@@ -116,6 +116,10 @@ class Planner {
         // With its bounds already known (item_bounds(e, moving) made them).
         Item(const Element& e, const ElementBounds& b)
             : geom(element_copy(e)), bounds(bounds_copy(b)) {}
+        // With the element make() returns built in place (no copy), and bounds(geom).
+        struct Made {};
+        template <class MakeElement>
+        Item(Made, MakeElement&& make) : geom(make()), bounds(motion::bounds(geom)) {}
         Element geom;
         ElementBounds bounds;  // bounds(geom), kept for the rate caps when it is emitted
         ElementLimits lim;
@@ -204,6 +208,15 @@ class Planner {
     // moving: as for Item.
     void add_item(const Element& e, double feed, double end_cap, bool rough, const Piece& owner,
                   bool rapid, double blend_centripetal = 0, std::span<const int> moving = {});
+    // add_item(make(), feed, end_cap, rough, owner, rapid) with the element built in place in
+    // its Item (a trimmed move: a 400-byte copy less), only if it is longer than kMinLength_mm
+    // (planner.cpp); returns its length either way.
+    template <class MakeElement>
+    double add_item_made(MakeElement&& make, double feed, double end_cap, bool rough,
+                         const Piece& owner, bool rapid);
+    // The rest of an Item once its element and bounds are in place.
+    void set_item_limits(Item& it, double feed, double end_cap, bool rough, const Piece& owner,
+                         bool rapid, double blend_centripetal);
     // add_item(e, feed, kInf, false, owner, rapid, ...) for an element whose bounds and limits
     // were already made as add_item() makes them (item_bounds(), then element_limits() with
     // the shares 1 - reserve_).
