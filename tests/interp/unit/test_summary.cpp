@@ -13,7 +13,7 @@ namespace {
 
 struct Case {
     SummarySink s;
-    void at(double x, double y, double z = 0) { s.emit(Canon{{}, canon::Traverse{{x, y, z}}}); }
+    void at(double x, double y, double z = 0) { s.emit(Canon{{}, canon::Traverse{{x, y, z}, {}}}); }
     void arc(double x, double y, int turns, double z = 0) {
         canon::Arc a;
         a.end_mm = {x, y, z};
