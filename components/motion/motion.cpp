@@ -42,8 +42,8 @@ constexpr char kUpperAxes[] = "XYZABCUVW";
 constexpr double kMaxOverride = 1.2;
 constexpr long kMaxDio = 64;  // NcStudio's M901 H0..H63
 
-// Why motion faulted, kept by the servo function for the text printed in the configuration
-// world (stop or unload). Drive faults and following errors are told by their own pins.
+// Why motion faulted, kept by the servo function for the text the non-realtime side makes of
+// it (on motion.messages as soon as the feeder thread polls, on stderr at stop or unload).
 enum class FaultCause : std::uint8_t {
     None,
     EStop,
@@ -52,7 +52,9 @@ enum class FaultCause : std::uint8_t {
     WaitTimeout,
     KinsLost,
     ToolOffsetJump,
-    JointSoftLimit
+    JointSoftLimit,
+    FollowingError,
+    AmpFault
 };
 struct FaultReport {
     FaultCause cause = FaultCause::None;
@@ -60,8 +62,9 @@ struct FaultReport {
     std::int32_t line = 0;
     motion::Action action;
     double amount = 0;  // ToolOffsetJump: how far the joint would have jumped; JointSoftLimit:
-                        // the joint's command
-    double min_mm = 0, max_mm = 0;  // JointSoftLimit: the joint's limits
+                        // the joint's command; FollowingError: the following error
+    double min_mm = 0, max_mm = 0;  // JointSoftLimit: the joint's limits; FollowingError:
+                                    // max_mm = joint.N.max-ferror
 };
 
 // The e-stop handshake of LinuxCNC's iocontrol: iocontrol.0.emc-enable-in FALSE trips it
@@ -171,7 +174,11 @@ class Motion : public hal::Instance {
         cfg.machine = sink_config();
         cfg.on_text = [this](const interp::Canon& c) { publish_text(c); };
         cfg.on_error = [this](const std::optional<interp::SourceLoc>& where,
-                              std::string_view cause) { publish_error(where, cause); };
+                              std::string_view cause) {
+            publish_fault();  // a servo fault noted first stopped the program first
+            publish_error(where, cause);
+        };
+        cfg.on_poll = [this] { publish_fault(); };
         error_published_ = false;  // a new run of the program (after a start that failed)
         feeder_ = std::make_unique<motioncomp::ProgramFeeder>(std::move(cfg), ring_);
         const bool failed_early = feeder_->start_and_wait_ready();
@@ -181,6 +188,7 @@ class Motion : public hal::Instance {
         // `start` plans the (perhaps corrected) file again.
         if (failed_early) {
             const std::string message = feeder_->error();
+            feeder_->stop();  // joined while feeder_ still points at it (on_poll reads it)
             feeder_.reset();
             sampler_.reset();
             while (ring_.size() > 0) ring_.pop();
@@ -251,7 +259,7 @@ class Motion : public hal::Instance {
         check_joint_limits(enabled, s.line);  // before check_joint_motion moves joint_prev_mm_
         check_joint_motion(p.s, s.line);
         // A joint limit tripped now drops the amps now, as a limit switch does.
-        if (write_joints(enabled && !limit_fault_) && !drive_fault_) {
+        if (write_joints(enabled && !limit_fault_, s.line) && !drive_fault_) {
             drive_fault_ = true;  // the stop ramp starts next period; amps drop now
             for (std::size_t j = 0; j < joint_count_; ++j) amp_enable_out_[j] = false;
         }
@@ -285,15 +293,34 @@ class Motion : public hal::Instance {
 
     // motion.messages, in the canonical stream's wire form, for `cnc run` or another reader:
     // M801 messages and warnings as commands, and the program's error as an end record with
-    // its place (file, line, column when known) apart from its cause. One producer at a time:
-    // the feeder thread while it runs (texts as they are planned; a planning error when it is
-    // found), the configuration world once it is joined (a fault of the servo function, at
-    // stop or unload). The servo function never writes it.
+    // its place (file, line, column when known) apart from its cause. hal::Stream is SPSC, so
+    // one producer at a time, handed over only where a thread join orders the two:
+    //  - the feeder thread from start() until stop() joins it: texts as they are planned, a
+    //    planning error when it is found, and a fault of the servo function within a
+    //    millisecond of the period that noted it (the thread stays after the program is over
+    //    to poll for that: ProgramFeeder::linger);
+    //  - the configuration world after the join (stop, unload, a start that failed): a fault
+    //    noted while no feeder thread ran (no program, or after stop), and nothing twice.
+    // The servo function never writes it: it only fills report_ and raises fault_noted_.
     void publish_text(const interp::Canon& c) {
         const std::size_t files = text_encoder_.files_announced();
         text_records_.clear();
         text_encoder_.command(c, text_records_);
         publish_records(files);
+    }
+
+    // The servo function's fault, once, by the stream's current producer (see above). The
+    // acquire pairs with note_fault()'s release: report_ is complete and no longer written.
+    void publish_fault() {
+        if (fault_published_ || !fault_noted_.load(std::memory_order_acquire)) return;
+        const std::string cause = fault_cause(report_);
+        if (names_line(report_.cause)) {
+            const std::string file = feeder_ ? feeder_->program_file() : program_path_;
+            publish_error(interp::SourceLoc{file, report_.line, 0}, cause);
+        } else {
+            publish_error(std::nullopt, cause);
+        }
+        fault_published_ = true;  // after: a throw above leaves it for the next poll
     }
 
     // The first error of a run only: the one that stopped the program.
@@ -413,9 +440,12 @@ class Motion : public hal::Instance {
         }
     }
 
-    // The first fault is the one reported.
+    // The first fault is the one reported. report_ is written once, before the release that
+    // lets the stream's producer read it (publish_fault), and never again.
     void note_fault(const FaultReport& r) noexcept {
-        if (report_.cause == FaultCause::None) report_ = r;
+        if (fault_noted_.load(std::memory_order_relaxed)) return;
+        report_ = r;
+        fault_noted_.store(true, std::memory_order_release);
     }
 
     // ---- machine commands (action records) ----
@@ -760,39 +790,48 @@ class Motion : public hal::Instance {
     }
 
     // Joint commands, following errors and amp enables; true if a drive reports a fault or a
-    // following error exceeds its limit while enabled.
-    bool write_joints(bool enabled) noexcept {
+    // following error exceeds its limit while enabled (the first such joint is noted, with
+    // `line`, the line running).
+    bool write_joints(bool enabled, std::int32_t line) noexcept {
         bool fault = false;
         for (std::size_t j = 0; j < joint_count_; ++j) {
             motor_pos_cmd_[j] = joint_cmd_mm_[j];
             const double ferror = joint_cmd_mm_[j] - motor_pos_fb_[j].get();
             const double limit = max_ferror_[j].get();
             const bool errored = limit > 0 && std::fabs(ferror) > limit;
+            const bool amp_fault = amp_fault_in_[j].get();
             f_error_[j] = ferror;
             f_error_lim_[j] = limit;
             f_errored_[j] = errored;
             amp_enable_out_[j] = enabled && !kins_lost_;
             // A disabled machine may sit anywhere: only an enabled one trips.
-            fault = fault || (enabled && (errored || amp_fault_in_[j].get()));
+            if (!enabled || fault || !(errored || amp_fault)) continue;
+            fault = true;
+            FaultReport report{amp_fault ? FaultCause::AmpFault : FaultCause::FollowingError,
+                               static_cast<int>(j), line, {}};
+            report.amount = ferror;
+            report.max_mm = limit;
+            note_fault(report);
         }
         return fault;
     }
 
     // An error met while the program was already running has only the fault pin in realtime;
-    // the text is printed here, in the configuration world, once. A servo function's fault goes
-    // to motion.messages from here too (the feeder thread, its other producer, is joined by
-    // now); the feeder thread sent its own error when it met it.
+    // the text is printed here, in the configuration world, once (on stderr at stop, so a HAL
+    // file's output keeps its order). Called after the feeder thread is joined, so this world
+    // is motion.messages' producer now: a servo fault the feeder thread has not published yet
+    // (none ran, or it came after the join) goes out from here; one it published is not sent
+    // again. The feeder thread sent its own error when it met it.
     void report_late_error() {
-        if (!fault_reported_ && report_.cause != FaultCause::None) {
+        publish_fault();
+        if (!fault_reported_ && fault_noted_.load(std::memory_order_acquire)) {
             fault_reported_ = true;
             const std::string cause = fault_cause(report_);
             if (names_line(report_.cause)) {
                 const std::string file = feeder_ ? feeder_->program_file() : program_path_;
                 fmt::print(stderr, "{}: {}:{}: {}\n", name(), file, report_.line, cause);
-                publish_error(interp::SourceLoc{file, report_.line, 0}, cause);
             } else {
                 fmt::print(stderr, "{}: {}\n", name(), cause);
-                publish_error(std::nullopt, cause);
             }
         }
         if (error_reported_ || !feeder_ || !feeder_->failed()) return;
@@ -800,10 +839,12 @@ class Motion : public hal::Instance {
         fmt::print(stderr, "{}: {}\n", name(), feeder_->error());
     }
 
-    // Faults of a program action or move, at its line (FaultReport::line).
+    // Faults of a program action or move, at its line (FaultReport::line): a following error
+    // is the path of the line running not being followed. A switch, the e-stop or a drive's own
+    // fault is the machine's, whatever line runs.
     static bool names_line(FaultCause c) {
         return c == FaultCause::WaitTimeout || c == FaultCause::ToolOffsetJump ||
-               c == FaultCause::JointSoftLimit;
+               c == FaultCause::JointSoftLimit || c == FaultCause::FollowingError;
     }
 
     // Why, without the place (names_line() tells whether the fault has one).
@@ -842,6 +883,16 @@ class Motion : public hal::Instance {
                     pin_name(fmt::format("joint.{}.{}-limit", r.joint,
                                          r.amount > r.max_mm ? "max" : "min")));
             }
+            case FaultCause::FollowingError:
+                return fmt::format(
+                    "joint {} following error {:.4f} mm, over its limit {} = {:g} mm; motion "
+                    "stopped, program abandoned",
+                    r.joint, r.amount, pin_name(fmt::format("joint.{}.max-ferror", r.joint)),
+                    r.max_mm);
+            case FaultCause::AmpFault:
+                return fmt::format(
+                    "joint {} drive fault ({}); motion stopped, program abandoned", r.joint,
+                    pin_name(fmt::format("joint.{}.amp-fault-in", r.joint)));
             case FaultCause::KinsLost:
                 return fmt::format(
                     "the kinematics kins={} was unloaded while motion used it; motion stopped, "
@@ -1176,6 +1227,8 @@ class Motion : public hal::Instance {
     interp::wire::Encoder text_encoder_;
     std::vector<interp::wire::Record> text_records_;
     bool error_published_ = false;
+    bool fault_published_ = false;    // report_ is on the stream (or was refused as not first)
+    std::atomic<bool> fault_noted_{false};  // the servo function filled report_ (release)
     std::atomic<std::uint32_t> dropped_texts_{0};  // the producer adds, the servo function reads
     motion::AxisArray home_shift_mm_{};  // machine coordinate minus planner frame (M902)
     bool limits_masked_ = false;         // M802 P131072 until P131073
@@ -1209,7 +1262,7 @@ class Motion : public hal::Instance {
     EStop estop_ = EStop::Resetting;  // ready as soon as emc-enable-in reads TRUE
     std::vector<char> pos_lim_seen_, neg_lim_seen_;  // last values, for rising edges
     std::vector<double> lim_prev_cmd_mm_;            // joint commands of the period before last
-    FaultReport report_;
+    FaultReport report_;  // the servo function's first fault; read after fault_noted_
     std::int32_t last_line_ = 0;  // motion.program-line as last written
     std::uint32_t starved_count_ = 0;
     bool lockstep_ = false;  // wait for the planner each period (simulated clock only)

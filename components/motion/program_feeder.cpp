@@ -50,8 +50,10 @@ ProgramFeeder::~ProgramFeeder() {
     stop();
 }
 
+// Also after the program is over (idle): the thread comes back to linger until the next stop(),
+// so a fault after a stop and start is published at once as well.
 bool ProgramFeeder::start_and_wait_ready() {
-    if (worker_.running() || idle_.load(std::memory_order_acquire)) return false;
+    if (worker_.running()) return false;
     return worker_.start_and_wait_ready([this] { run(); });
 }
 
@@ -274,6 +276,7 @@ void ProgramFeeder::run() noexcept {
         }
     }
     while (!stopping()) {
+        poll_owner();
         deliver();
         if (ring_.free_slots() == 0) mark_ready();  // a full lead: start() may return
         reach_barrier_if_delivered();
@@ -322,6 +325,29 @@ void ProgramFeeder::run() noexcept {
     if ((program_done_ && outbox_.empty()) || abandoned_.load(std::memory_order_relaxed))
         idle_.store(true, std::memory_order_release);
     mark_ready();
+    linger();
+}
+
+// The program is over (or abandoned, which a servo fault does in the period it is seen), but
+// the machine may stay loaded and fault later, or has just faulted: the thread stays, the
+// stream's producer, until stop() joins it. Polling, because the servo function may not wake
+// a thread (a futex is a system call); a millisecond is far below what an operator notices
+// and costs nothing next to the planning loop's own 50-200 us naps.
+void ProgramFeeder::linger() noexcept {
+    while (!worker_.pause_requested()) {
+        poll_owner();
+        std::this_thread::sleep_for(kLingerPoll);
+    }
+}
+
+void ProgramFeeder::poll_owner() noexcept {
+    if (!cfg_.on_poll) return;
+    try {
+        cfg_.on_poll();
+    } catch (const std::exception&) {
+        // Out of memory formatting a text: the owner tries again at the next poll, and its
+        // own report at stop() comes after this thread is joined.
+    }
 }
 
 ProgramFeeder::Progress ProgramFeeder::step() {

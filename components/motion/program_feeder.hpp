@@ -13,6 +13,7 @@
 
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <deque>
 #include <exception>
@@ -63,17 +64,29 @@ struct FeederConfig {
     // runs out): where (nullopt when no place is known; the file view lives as long as the
     // call) and the cause, without the place. error() has the whole text.
     std::function<void(const std::optional<interp::SourceLoc>&, std::string_view cause)> on_error;
+    // On the feeder thread, between the planning steps and, once nothing more is planned (the
+    // program ended, failed or was abandoned), about every kLingerPoll until stop(). The thread
+    // is the owner's one non-realtime thread that lives from start() to stop(): motion uses it
+    // to publish a servo function's fault on motion.messages while the machine is still
+    // loaded (the stream has one producer at a time, and this thread is it until joined).
+    std::function<void()> on_poll;
 };
 
 class ProgramFeeder {
   public:
+    // How often on_poll runs once the program is over: the latency of a fault's text on
+    // motion.messages after the servo function has noted it.
+    static constexpr std::chrono::milliseconds kLingerPoll{1};
+
+
     ProgramFeeder(FeederConfig cfg, motion::SpscRing<motion::PreparedSegment>& ring);
     ~ProgramFeeder();
     ProgramFeeder(const ProgramFeeder&) = delete;
     ProgramFeeder& operator=(const ProgramFeeder&) = delete;
 
     // Configuration world. Starts (or resumes, after stop()) the thread and blocks until the
-    // whole program is planned and in the ring, the ring is full, or the program failed. This
+    // whole program is planned and in the ring, the ring is full, or the program failed. The
+    // thread then stays until stop(), also once the program is over (see on_poll). This
     // is what makes a simulated-clock run deterministic: the servo function never sees a
     // half-planned queue unless the program is longer than the ring. Returns true if the
     // program had failed by then (decided at that moment, so the answer does not depend on
@@ -130,6 +143,8 @@ class ProgramFeeder {
   private:
     enum class Progress { More, Starved, End };
     void run() noexcept;
+    void linger() noexcept;
+    void poll_owner() noexcept;
     void open_program();
     Progress step();
     Progress read_stream();

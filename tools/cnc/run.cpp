@@ -59,6 +59,10 @@ constexpr double kPollPeriodS = 0.005;  // real-time clock: how often the pins a
 constexpr double kEnableGraceS = 1.0;   // the machine must be enabled within this
 constexpr double kAbortGraceS = 10.0;   // after Ctrl-C: time allowed for the stop ramp
 constexpr double kTtyRedrawS = 0.1;     // progress bar redraw interval, wall time
+// A fault at rest whose cause has not arrived on motion.messages yet: how long (wall time) to
+// wait for it before `stop`. motion sends it within a millisecond or so of the fault; under
+// --sim-clock the machine can come to rest in less wall time than that.
+constexpr double kFaultTextWaitS = 1.0;
 constexpr int kBarWidth = 30;
 
 // Ctrl-C, SIGTERM and SIGHUP are taken by one waiter thread, so the HAL threads (which
@@ -439,6 +443,13 @@ class OperatorTexts {
     // The first error motion sent, if any (poll() first).
     const std::optional<ProgramError>& error() const { return error_; }
 
+    // On a terminal: clears the progress bar before a line of text (its next update redraws it).
+    void clear_bar() {
+        if (!tty_) return;
+        fmt::print("\r\x1b[K");
+        std::fflush(stdout);
+    }
+
     void poll() {
         if (!ring_) return;
         while (ring_->pop(record_.data())) take();
@@ -473,11 +484,6 @@ class OperatorTexts {
             fmt::print(stderr, "{}:{}:{}: warning: {}\n", c.loc.file, c.loc.line, c.loc.col,
                        w->text);
         }
-    }
-    void clear_bar() {
-        if (!tty_) return;
-        fmt::print("\r\x1b[K");
-        std::fflush(stdout);
     }
 
     hal::Ring* ring_ = nullptr;
@@ -596,7 +602,8 @@ std::array<double, 3> xyz_of(const MachinePins& p, const Sample& s) {
 struct LoopResult {
     Outcome outcome = Outcome::Finished;
     std::string fault_text;
-    int fault_line = 0;  // the program line when the fault appeared
+    int fault_line = 0;          // the program line when the fault appeared
+    bool fault_printed = false;  // its error line is on stderr already (announce_fault)
     Sample last;
     long samples = 0;
 };
@@ -618,6 +625,49 @@ bool operator_pressed_enter() {
     return n > 0 && std::memchr(buffer, '\n', static_cast<std::size_t>(n)) != nullptr;
 }
 
+// A fault's error line. A drive fault or following error names the line running when it came;
+// motion's own error names the line it is about (a move refused after the machine started
+// names the refused line, not the one running) or, for one without a place (a limit switch),
+// the line running.
+std::string fault_error(const RunOptions& o, const LoopResult& r,
+                        const std::optional<ProgramError>& motion_error) {
+    const std::string running = fmt::format("{}:{}", o.program, r.fault_line);
+    if (!r.fault_text.empty()) return fmt::format("{}: {}", running, r.fault_text);
+    if (motion_error)
+        return fmt::format("{}: {}", motion_error->place.empty() ? running : motion_error->place,
+                           motion_error->cause);
+    return fmt::format("{}: motion fault (the cause is in motion's message on stderr)", running);
+}
+
+// A fault's error line on stderr once its cause is known, while the machine is still coming to
+// rest: a drive fault or following error at once (from the pins), any other fault when motion's
+// end record arrives on motion.messages (motion publishes it within about a millisecond). The
+// same line ends the run; this one tells the operator why the machine is stopping.
+void announce_fault(const RunOptions& o, LoopResult& r, OperatorTexts& texts) {
+    if (r.outcome != Outcome::Fault || r.fault_printed) return;
+    if (r.fault_text.empty() && !texts.error()) return;
+    r.fault_printed = true;
+    texts.clear_bar();
+    fmt::print(stderr, "{}\n", fault_error(o, r, texts.error()));
+    std::fflush(stderr);
+}
+
+// After a fault, before `stop`: waits (wall time, at most kFaultTextWaitS) for motion's cause,
+// so the error line comes out before motion's own message at stop on every run, also under
+// --sim-clock, where the machine may be at rest before motion has published it.
+void await_fault_text(const RunOptions& o, LoopResult& r, OperatorTexts& texts) {
+    const auto deadline = std::chrono::steady_clock::now() +
+                          std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                              std::chrono::duration<double>(kFaultTextWaitS));
+    for (;;) {
+        texts.poll();
+        announce_fault(o, r, texts);
+        if (r.outcome != Outcome::Fault || r.fault_printed) return;
+        if (std::chrono::steady_clock::now() >= deadline) return;
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+}
+
 // Steps the clock until the program ends or something stops it. `step` moves time on (one
 // servo period, or a poll interval of wall time) and returns the time since start.
 LoopResult watch(Session& session, const MachinePins& pins, const RunOptions& o,
@@ -636,6 +686,7 @@ LoopResult watch(Session& session, const MachinePins& pins, const RunOptions& o,
         stats.add(s);
         progress.update(s.t_s, s.line);
         texts.poll();
+        announce_fault(o, r, texts);
         if (abort_at_s) {
             if (s.in_position || s.t_s > *abort_at_s + kAbortGraceS) return r;
             continue;
@@ -654,6 +705,7 @@ LoopResult watch(Session& session, const MachinePins& pins, const RunOptions& o,
             r.outcome = Outcome::Fault;
             r.fault_text = describe_fault(pins, s);
             r.fault_line = s.line;
+            announce_fault(o, r, texts);
             continue;
         }
         ever_enabled = ever_enabled || s.enabled;
@@ -883,20 +935,6 @@ std::function<void(Sample&)> make_source(Session& session, const MachinePins& pi
     };
 }
 
-// A fault's error line. A drive fault or following error names the line running when it came;
-// motion's own error names the line it is about (a move refused after the machine started
-// names the refused line, not the one running) or, for one without a place (a limit switch),
-// the line running.
-std::string fault_error(const RunOptions& o, const LoopResult& r,
-                        const std::optional<ProgramError>& motion_error) {
-    const std::string running = fmt::format("{}:{}", o.program, r.fault_line);
-    if (!r.fault_text.empty()) return fmt::format("{}: {}", running, r.fault_text);
-    if (motion_error)
-        return fmt::format("{}: {}", motion_error->place.empty() ? running : motion_error->place,
-                           motion_error->cause);
-    return fmt::format("{}: motion fault (the cause is in motion's message on stderr)", running);
-}
-
 // The error line for an outcome other than Finished: `PROGRAM:LINE: what`.
 std::string outcome_error(const RunOptions& o, const LoopResult& r,
                           const std::optional<ProgramError>& motion_error) {
@@ -978,9 +1016,10 @@ int run_session(const RunOptions& o, const Config& c, Session& session, const St
     Stats stats(pins.letters, pins.ferror.size(), o.sim_clock || stream, c.period_s);
     Progress progress(c.program_lines, ::isatty(STDOUT_FILENO) == 1);
     OperatorTexts texts(session.runtime, ::isatty(STDOUT_FILENO) == 1);
-    const LoopResult r =
+    LoopResult r =
         watch(session, pins, o, make_source(session, pins, o, c.period_s, stream.get()), stats,
               progress, texts, trace.get(), preview.get(), stop);
+    await_fault_text(o, r, texts);
     progress.finish(r.last.t_s, r.outcome == Outcome::Finished);
     session.exec({"stop"});  // motion prints a late error here (and sends a servo fault's)
     texts.poll();
