@@ -807,8 +807,10 @@ class Motion : public hal::Instance {
             // A disabled machine may sit anywhere: only an enabled one trips.
             if (!enabled || fault || !(errored || amp_fault)) continue;
             fault = true;
-            FaultReport report{amp_fault ? FaultCause::AmpFault : FaultCause::FollowingError,
-                               static_cast<int>(j), line, {}};
+            FaultReport report;
+            report.cause = amp_fault ? FaultCause::AmpFault : FaultCause::FollowingError;
+            report.joint = static_cast<int>(j);
+            report.line = line;
             report.amount = ferror;
             report.max_mm = limit;
             note_fault(report);
@@ -890,9 +892,9 @@ class Motion : public hal::Instance {
                     r.joint, r.amount, pin_name(fmt::format("joint.{}.max-ferror", r.joint)),
                     r.max_mm);
             case FaultCause::AmpFault:
-                return fmt::format(
-                    "joint {} drive fault ({}); motion stopped, program abandoned", r.joint,
-                    pin_name(fmt::format("joint.{}.amp-fault-in", r.joint)));
+                return fmt::format("joint {} drive fault ({}); motion stopped, program abandoned",
+                                   r.joint,
+                                   pin_name(fmt::format("joint.{}.amp-fault-in", r.joint)));
             case FaultCause::KinsLost:
                 return fmt::format(
                     "the kinematics kins={} was unloaded while motion used it; motion stopped, "
@@ -1227,8 +1229,8 @@ class Motion : public hal::Instance {
     interp::wire::Encoder text_encoder_;
     std::vector<interp::wire::Record> text_records_;
     bool error_published_ = false;
-    bool fault_published_ = false;    // report_ is on the stream (or was refused as not first)
-    std::atomic<bool> fault_noted_{false};  // the servo function filled report_ (release)
+    bool fault_published_ = false;  // report_ is on the stream (or was refused as not first)
+    std::atomic<bool> fault_noted_{false};         // the servo function filled report_ (release)
     std::atomic<std::uint32_t> dropped_texts_{0};  // the producer adds, the servo function reads
     motion::AxisArray home_shift_mm_{};  // machine coordinate minus planner frame (M902)
     bool limits_masked_ = false;         // M802 P131072 until P131073
@@ -1262,7 +1264,7 @@ class Motion : public hal::Instance {
     EStop estop_ = EStop::Resetting;  // ready as soon as emc-enable-in reads TRUE
     std::vector<char> pos_lim_seen_, neg_lim_seen_;  // last values, for rising edges
     std::vector<double> lim_prev_cmd_mm_;            // joint commands of the period before last
-    FaultReport report_;  // the servo function's first fault; read after fault_noted_
+    FaultReport report_;          // the servo function's first fault; read after fault_noted_
     std::int32_t last_line_ = 0;  // motion.program-line as last written
     std::uint32_t starved_count_ = 0;
     bool lockstep_ = false;  // wait for the planner each period (simulated clock only)

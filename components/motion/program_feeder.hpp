@@ -78,7 +78,6 @@ class ProgramFeeder {
     // motion.messages after the servo function has noted it.
     static constexpr std::chrono::milliseconds kLingerPoll{1};
 
-
     ProgramFeeder(FeederConfig cfg, motion::SpscRing<motion::PreparedSegment>& ring);
     ~ProgramFeeder();
     ProgramFeeder(const ProgramFeeder&) = delete;

@@ -39,10 +39,10 @@ std::string mill_with_limit_switch_at_20() {
 TEST(CncRunFaultLive, G906TimeoutErrorLineComesFirst) {
     ScratchDir scratch;
     const fs::path ini = write_file(scratch, "machine.ini", cnc_test::sim_ini("mill"));
-    const fs::path prog = write_file(scratch, "prog.ngc",
-                                     "G90 G21\nG1 X10 F6000\nG906 PLC[0] LEVEL1 P500\nG1 X20\nM30\n");
-    const RunResult r = run_cnc(
-        fmt::format("'{}' '{}' --sim-clock", ini.string(), prog.string()), scratch.path());
+    const fs::path prog = write_file(
+        scratch, "prog.ngc", "G90 G21\nG1 X10 F6000\nG906 PLC[0] LEVEL1 P500\nG1 X20\nM30\n");
+    const RunResult r =
+        run_cnc(fmt::format("'{}' '{}' --sim-clock", ini.string(), prog.string()), scratch.path());
     const std::string error =
         prog.string() + ":3: G906: motion.digital-in-00 did not become TRUE within 0.5 s";
     EXPECT_EQ(r.exit_code, 1);
@@ -56,8 +56,8 @@ TEST(CncRunFaultLive, LimitSwitchErrorLineComesFirst) {
     ScratchDir scratch;
     const fs::path ini = write_file(scratch, "machine.ini", mill_with_limit_switch_at_20());
     const fs::path prog = write_file(scratch, "prog.ngc", "G90 G21\nG1 X30 F3000\nM30\n");
-    const RunResult r = run_cnc(
-        fmt::format("'{}' '{}' --sim-clock", ini.string(), prog.string()), scratch.path());
+    const RunResult r =
+        run_cnc(fmt::format("'{}' '{}' --sim-clock", ini.string(), prog.string()), scratch.path());
     const std::string cause =
         "joint 0 hit its positive limit switch (joint.0.pos-lim-sw-in); motion stopped, program "
         "abandoned";

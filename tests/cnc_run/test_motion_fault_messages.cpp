@@ -43,9 +43,9 @@ class MotionMachine {
     // started. `setup` lines run before `start`.
     MotionMachine(const std::string& program, const std::vector<std::string>& setup = {}) {
         static int counter = 0;
-        rt_ = std::make_unique<hal::Runtime>(hal::Runtime::Options{
-            fmt::format("t-fault-msg-{}-{}", ::getpid(), ++counter), hal::kDefaultSegmentBytes,
-            true});
+        rt_ = std::make_unique<hal::Runtime>(
+            hal::Runtime::Options{fmt::format("t-fault-msg-{}-{}", ::getpid(), ++counter),
+                                  hal::kDefaultSegmentBytes, true});
         program_ = (scratch_.path() / "prog.ngc").string();
         std::ofstream(program_) << program;
         run(fmt::format("loadrt motion program={}", program_));
@@ -86,11 +86,10 @@ class MotionMachine {
             ++ends_;
             if (!decoder_.failed()) continue;
             const auto& at = decoder_.error_loc();
-            end_ = EndRecord{
-                !at ? ""
-                : at->col > 0 ? fmt::format("{}:{}:{}", at->file, at->line, at->col)
-                              : fmt::format("{}:{}", at->file, at->line),
-                decoder_.error_cause()};
+            end_ = EndRecord{!at           ? ""
+                             : at->col > 0 ? fmt::format("{}:{}:{}", at->file, at->line, at->col)
+                                           : fmt::format("{}:{}", at->file, at->line),
+                             decoder_.error_cause()};
         }
         return ends_ > 0;
     }

@@ -1016,9 +1016,8 @@ int run_session(const RunOptions& o, const Config& c, Session& session, const St
     Stats stats(pins.letters, pins.ferror.size(), o.sim_clock || stream, c.period_s);
     Progress progress(c.program_lines, ::isatty(STDOUT_FILENO) == 1);
     OperatorTexts texts(session.runtime, ::isatty(STDOUT_FILENO) == 1);
-    LoopResult r =
-        watch(session, pins, o, make_source(session, pins, o, c.period_s, stream.get()), stats,
-              progress, texts, trace.get(), preview.get(), stop);
+    LoopResult r = watch(session, pins, o, make_source(session, pins, o, c.period_s, stream.get()),
+                         stats, progress, texts, trace.get(), preview.get(), stop);
     await_fault_text(o, r, texts);
     progress.finish(r.last.t_s, r.outcome == Outcome::Finished);
     session.exec({"stop"});  // motion prints a late error here (and sends a servo fault's)
