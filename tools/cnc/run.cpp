@@ -442,6 +442,8 @@ class OperatorTexts {
 
     // The first error motion sent, if any (poll() first).
     const std::optional<ProgramError>& error() const { return error_; }
+    // False when the config's motion has no motion.messages: no error will come from it.
+    bool connected() const { return ring_ != nullptr; }
 
     // On a terminal: clears the progress bar before a line of text (its next update redraws it).
     void clear_bar() {
@@ -656,6 +658,7 @@ void announce_fault(const RunOptions& o, LoopResult& r, OperatorTexts& texts) {
 // so the error line comes out before motion's own message at stop on every run, also under
 // --sim-clock, where the machine may be at rest before motion has published it.
 void await_fault_text(const RunOptions& o, LoopResult& r, OperatorTexts& texts) {
+    if (!texts.connected()) return;
     const auto deadline = std::chrono::steady_clock::now() +
                           std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                               std::chrono::duration<double>(kFaultTextWaitS));
