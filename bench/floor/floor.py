@@ -497,7 +497,7 @@ class SectionModel:
                 lo_k = eb + 1
             else:
                 lo_k = ea + 1
-                while lo_k < eb and self.min_time(el[lo_k][1], b) >= (U - k) * h - 1e-12:
+                while lo_k < eb and self.min_time(el[lo_k][1], b) >= (U - k) * h + 1e-12:
                     lo_k += 1
             win[k] = (lo_k, hi)
         # Keep the windows monotone in k (true of the real assignment).
@@ -896,6 +896,9 @@ def main():
     ap.add_argument("--single", action="store_true",
                     help="one MILP minimising the count within the horizon (its dual bound is "
                     "the floor) instead of the bisection on the horizon")
+    ap.add_argument("--prove-ms", type=float, default=None,
+                    help="only try to prove t_b - t_a >= this (one feasibility MILP at this "
+                    "horizon, e.g. with a longer --time-limit after a bisection)")
     ap.add_argument("--presolve", action="store_true",
                     help="use HiGHS's presolve (faster, but HiGHS 1.2's once declared a real "
                     "motion infeasible: not for proofs)")
@@ -910,6 +913,17 @@ def main():
     try:
         moves = parse_program(args.program, args.tolerance)
         a, b = section_vertices(moves, first, last)
+        if args.prove_ms is not None:
+            model = make_model(moves, a, b, args.vmax, args.amax, args.step_ms, args.lead_in,
+                               args.lead_out, args.prove_ms * 1e-3, args.perp, args.group_deg)
+            model.presolve = args.presolve
+            res = model.solve(args.time_limit, args.verbose, feasibility=True)
+            verdict = {"infeasible in horizon": f"proved: t_b - t_a >= {model.U * model.h:.3f} s",
+                       "feasible": "not proved: the relaxation has a motion this fast",
+                       "unknown": "not proved: time limit"}[res.status]
+            print(f"lines {first}-{last}, horizon {model.U * model.h * 1e3:.0f} ms: {verdict} "
+                  f"({res.solve_s:.1f} s)")
+            return
         res = section_floor(moves, a, b, args.vmax, args.amax, args.step_ms, args.lead_in,
                             args.lead_out, None if args.horizon_ms is None else
                             args.horizon_ms * 1e-3, args.time_limit, args.perp, args.verbose,
