@@ -419,13 +419,13 @@ void rate_path(RateState s, double target, double dt, const RateLimits& lim,
     if (left > 0) out.add({0, left, false, -1});
 }
 
-// r' towards -vm at r'' = -am (back towards it at +am when beyond), then held, for dt: a
-// slowing move that leaves the landing to its backup.
-void ramp_path(RateState s, double vm, double am, double dt, RatePath& out) noexcept {
+// r' towards rd_goal at |r''| = am, then held, for dt: a move that leaves the landing to its
+// backup (slowing: rd_goal < 0; speeding up: rd_goal > 0).
+void ramp_path(RateState s, double rd_goal, double am, double dt, RatePath& out) noexcept {
     double left = dt;
-    if (s.rd != -vm) {
-        const double h = std::min(left, std::fabs(s.rd + vm) / am);
-        out.add({s.rd > -vm ? -am : am, h, false, -1});
+    if (s.rd != rd_goal) {
+        const double h = std::min(left, std::fabs(s.rd - rd_goal) / am);
+        out.add({s.rd > rd_goal ? -am : am, h, false, -1});
         left -= h;
     }
     if (left > 0) out.add({0, left, false, -1});
@@ -490,114 +490,14 @@ double Sampler::advance_rate_jerk(double target, double dt) noexcept {
     }
     double vm_acc = 0;
     const RateLimits room = jerk_room_limits(target, dt, &vm_acc);
-    if (target < r_ && target < 1 && r_ <= kPlannedRate) {
-        // Slowing (a hold, an abort, an override down), in the order tried:
-        // - ramp: r'' < 0 with the room the plan's jerk leaves on that side (signed_jerk_room():
-        //   nearly 2 J against the plan's jerk), r' down to the acceleration room of this
-        //   period at the rate now (vm_acc, over the whole stretch ahead, assumes the rate may
-        //   fall to 0 there, where a r^2 no longer helps);
-        // - where r'' < 0 has no room (the plan's terms alone pull the tangential jerk to -J,
-        //   or nearly): the least r'' that keeps it there, often 0 (coasting);
-        // each taken only while the backup from its end (coast_backup()) still lands at or
-        // above the target and the whole passes the check;
-        // - else land now along a fresh backup (its first period).
-        // So the rate falls as fast as the jerk and the acceleration allow and the landing
-        // comes as late as the room allows, as in the shortest stop. The room for r'' < 0
-        // over this period falls as r' grows more negative in it (the 3 a r r' term), nearly
-        // linearly in |r''|: the room f0 at r' as it is, f1 at the cap, and the crossing
-        // |r''| = f(|r''|) of the line through them, taken once more.
-        const double pad = r_ * dt + kWalkPadS;
-        double rd_room = 0, brake_min = 0;
-        auto room_down = [&](double am) {
-            const RateSpan box{std::max(0.0, r_ + (std::min(rd_, 0.0) - am * dt) * dt), r_,
-                               rd_ - am * dt, rd_, 0};
-            WalkFrom at;
-            const SignedRoom sr = signed_jerk_room(tau_, tau_ + pad, box, at);
-            rd_room = sr.rd_down;
-            brake_min = sr.up_min;
-            return sr.down;
-        };
-        const double f0 = room_down(0);
-        const double least_brake = brake_min;
-        const double am_cap = std::min(f0, cfg_.max_rate / (kRateRampS * kRateRampS));
-        double am1 = 0;
-        if (am_cap > rl_.max_rate_per_s2) {
-            const double f1 = room_down(am_cap);
-            const double slope = std::max(0.0, (f0 - f1) / am_cap);
-            const double guess = std::min(am_cap, f0 / (1 + slope));
-            am1 = am_cap;
-            if (guess < am_cap) {
-                // Once more along the line through (guess, f(guess)) and (am_cap, f1): the room
-                // is not quite linear in |r''|, and the first crossing falls short of it.
-                const double fg = room_down(guess);
-                am1 = std::min(guess, fg);
-                const double s = (f1 - fg) / (am_cap - guess);
-                const double better = s < 0 ? (fg - s * guess) / (1 - s) : am_cap;
-                if (fg > guess && better > guess)
-                    am1 = std::max(am1, std::min(better, room_down(better)));
-            }
-        }
-        const double vm_move = std::clamp(rd_room, vm_acc, cfg_.max_rate / kRateRampS);
-        auto try_move = [&](const RatePath& move, double am_hint) {
-            RateState end{r_, rd_};
-            double tau_end = tau_;
-            for (int i = 0; i < move.count; ++i)
-                tau_end += step_rate(end, move.pieces[static_cast<std::size_t>(i)]);
-            RatePath backup;
-            double r_end = 0;
-            if (!coast_backup(end.r, end.rd, tau_end, am_hint, backup, r_end) ||
-                r_end < target - 1e-9)
-                return false;
-            RatePath whole = move;
-            for (int i = 0; i < backup.count; ++i)
-                whole.add(backup.pieces[static_cast<std::size_t>(i)]);
-            if (whole.count >= RatePath::kMaxPieces || !rate_path_safe(whole)) return false;
-            cert_ = backup;
-            // What the next periods' reach estimates (jerk_room_limits(), rate_cap_ahead())
-            // take as the r' to brake and the r'' to brake it with: the r' reached, not the cap.
-            last_limits_ = {std::max(std::fabs(end.rd), rl_.max_rate_per_s),
-                            std::max(am_hint, room.max_rate_per_s2)};
-            return true;
-        };
-        if (am1 > rl_.max_rate_per_s2) {
-            RatePath move;
-            ramp_path({r_, rd_}, kRampShare * vm_move, am1, dt, move);
-            if (try_move(move, am1)) return apply_rate(move);
-        } else if (rd_ < 0) {
-            RatePath move;
-            const double u = least_brake * (1 + 1e-6);
-            const double h = u > 0 ? std::min(dt, -rd_ / u) : dt;
-            move.add({u, h, h < dt, -1});
-            if (h < dt) move.add({0, dt - h, false, -1});
-            if (try_move(move, std::max(u, room.max_rate_per_s2))) return apply_rate(move);
-        }
-        if (rd_ < 0) {
-            // The same pieces after a coast that lowers r by as much as they would land above
-            // the target land on it, which a hold needs to end (r = 0).
-            RatePath landing;
-            double r_end = 0;
-            const double hint = std::max(am1, room.max_rate_per_s2);
-            if (coast_backup(r_, rd_, tau_, hint, landing, r_end)) {
-                RatePath shifted;
-                if (r_end > target && r_end <= kPlannedRate) {
-                    shifted.add({0, (r_end - target) / -rd_, false, -1});
-                    for (int i = 0; i < landing.count; ++i)
-                        shifted.add(landing.pieces[static_cast<std::size_t>(i)]);
-                    RatePiece& last = shifted.pieces[static_cast<std::size_t>(shifted.count - 1)];
-                    if (last.zero_rd) last.r_snap = target;
-                }
-                for (RatePath* path : {&shifted, &landing}) {
-                    if (path->count == 0 || path->count == RatePath::kMaxPieces ||
-                        !rate_path_safe(*path))
-                        continue;
-                    RatePath head;
-                    split_path(*path, dt, head);
-                    cert_ = *path;
-                    last_limits_ = {std::max(-rd_, rl_.max_rate_per_s), hint};
-                    return apply_rate(head);
-                }
-            }
-        }
+    // Slowing (a hold, an abort, an override down) and speeding up towards a rate <= 1 (an
+    // override up; a target above 1 is reached through 1) try the directed moves first.
+    const bool slowing = target < r_ && target < 1 && r_ <= kPlannedRate;
+    const bool raising = target > r_ && r_ < 1;
+    if (slowing || raising) {
+        double passed = 0;
+        if (directed_moves(slowing ? target : std::min(target, 1.0), dt, room, vm_acc, passed))
+            return passed;
     }
     for (double scale : {1.0, 0.25}) {
         const RateLimits lim{room.max_rate_per_s * scale, room.max_rate_per_s2 * scale};
@@ -617,6 +517,163 @@ double Sampler::advance_rate_jerk(double target, double dt) noexcept {
     RatePath head;
     split_path(cert_, dt, head);
     return apply_rate(head);
+}
+
+// The directed moves of a rate change towards `goal` (module comment in sampler.hpp): while
+// slowing (goal < r) r'' < 0 against the plan's jerk, while speeding up (goal > r, goal <= 1)
+// r'' > 0 likewise, each with a backup from its end that brakes r' in pieces at the room of
+// each stretch (coast_backup()) and still lands on the near side of the goal; else the least
+// r'' that keeps the tangential jerk within the limit; else the landing along a fresh backup.
+// True with the planned time passed when one of them was taken.
+bool Sampler::directed_moves(double goal, double dt, const RateLimits& room, double vm_acc,
+                             double& passed) noexcept {
+    const bool down = goal < r_;
+    // sg: the sign of the r' the move heads for; r'' of that sign speeds the change.
+    const double sg = down ? -1.0 : 1.0;
+    // In the order tried:
+    // - ramp: r'' of sign sg with the room the plan's jerk leaves on that side
+    //   (signed_jerk_room(): nearly 2 J against the plan's jerk), r' to the acceleration room
+    //   of this period at the rate now (vm_acc, over the whole stretch ahead, assumes the rate
+    //   may fall to 0 there, where a r^2 no longer helps a slowing move);
+    // - where that side has no room (the plan's terms alone pull the tangential jerk to the
+    //   limit, or nearly): the least r'' that keeps it there, often 0 (coasting);
+    // each taken only while the backup from its end (coast_backup()) still lands on the near
+    // side of the goal and the whole passes the check;
+    // - else land now along a fresh backup (its first period).
+    // So the rate changes as fast as the jerk and the acceleration allow and the landing
+    // comes as late as the room allows, as in the shortest stop. The room for r'' over this
+    // period falls as r' grows in it (the 3 a r r' term), nearly linearly in |r''|: the room
+    // f0 at r' as it is, f1 at the cap, and the crossing |r''| = f(|r''|) of the line through
+    // them, taken once more.
+    const double rise = std::max(rd_, 0.0) * dt;
+    const double pad = (r_ + (down ? 0.0 : rise)) * dt + kWalkPadS;
+    double rd_room = 0, brake_min = 0;
+    auto room_toward = [&](double am) {
+        WalkFrom at;
+        if (down) {
+            const RateSpan box{std::max(0.0, r_ + (std::min(rd_, 0.0) - am * dt) * dt), r_,
+                               rd_ - am * dt, rd_, 0};
+            const SignedRoom sr = signed_jerk_room(tau_, tau_ + pad, box, at);
+            rd_room = sr.rd_down;
+            brake_min = sr.up_min;
+            return sr.down;
+        }
+        const RateSpan box{std::max(0.0, r_ + std::min(rd_, 0.0) * dt), r_ + rise + am * dt * dt,
+                           rd_, rd_ + am * dt, 0};
+        const SignedRoom sr = signed_jerk_room(tau_, tau_ + pad + am * dt * dt * dt, box, at);
+        rd_room = sr.rd_up;
+        brake_min = sr.down_min;
+        return sr.up;
+    };
+    const double f0 = room_toward(0);
+    const double least_brake = brake_min;
+    const double am_cap = std::min(f0, cfg_.max_rate / (kRateRampS * kRateRampS));
+    double am1 = 0;
+    if (am_cap > rl_.max_rate_per_s2) {
+        const double f1 = room_toward(am_cap);
+        const double slope = std::max(0.0, (f0 - f1) / am_cap);
+        const double guess = std::min(am_cap, f0 / (1 + slope));
+        am1 = am_cap;
+        if (guess < am_cap) {
+            // Once more along the line through (guess, f(guess)) and (am_cap, f1): the room
+            // is not quite linear in |r''|, and the first crossing falls short of it.
+            const double fg = room_toward(guess);
+            am1 = std::min(guess, fg);
+            const double s = (f1 - fg) / (am_cap - guess);
+            const double better = s < 0 ? (fg - s * guess) / (1 - s) : am_cap;
+            if (fg > guess && better > guess)
+                am1 = std::max(am1, std::min(better, room_toward(better)));
+        }
+    }
+    const double vm_move = std::clamp(rd_room, vm_acc, cfg_.max_rate / kRateRampS);
+    auto try_move = [&](const RatePath& move, double am_hint) {
+        RateState end{r_, rd_};
+        double tau_end = tau_;
+        for (int i = 0; i < move.count; ++i)
+            tau_end += step_rate(end, move.pieces[static_cast<std::size_t>(i)]);
+        RatePath backup;
+        double r_end = 0;
+        if (!coast_backup(end.r, end.rd, tau_end, am_hint, backup, r_end) ||
+            (down ? r_end < goal - 1e-9 : r_end > goal + 1e-9))
+            return false;
+        RatePath whole = move;
+        for (int i = 0; i < backup.count; ++i)
+            whole.add(backup.pieces[static_cast<std::size_t>(i)]);
+        if (whole.count >= RatePath::kMaxPieces || !rate_path_safe(whole)) return false;
+        cert_ = backup;
+        // What the next periods' reach estimates (jerk_room_limits(), rate_cap_ahead())
+        // take as the r' to brake and the r'' to brake it with: the r' reached, not the cap.
+        last_limits_ = {std::max(std::fabs(end.rd), rl_.max_rate_per_s),
+                        std::max(am_hint, room.max_rate_per_s2)};
+        return true;
+    };
+    if (am1 > rl_.max_rate_per_s2) {
+        RatePath move;
+        ramp_path({r_, rd_}, sg * kRampShare * vm_move, am1, dt, move);
+        if (try_move(move, am1)) {
+            passed = apply_rate(move);
+            return true;
+        }
+        if (!down && approach(goal, dt, {kRampShare * vm_move, am1}, passed)) return true;
+    } else if (sg * rd_ > 0) {
+        RatePath move;
+        const double u = least_brake * (1 + 1e-6);
+        const double h = u > 0 ? std::min(dt, sg * rd_ / u) : dt;
+        move.add({-sg * u, h, h < dt, -1});
+        if (h < dt) move.add({0, dt - h, false, -1});
+        if (try_move(move, std::max(u, room.max_rate_per_s2))) {
+            passed = apply_rate(move);
+            return true;
+        }
+    }
+    if (sg * rd_ <= 0) return false;
+    // The same pieces after a coast that takes r as far as they would land short of the
+    // goal land on it, which a hold needs to end (r = 0) and a rise to end at its target.
+    RatePath landing;
+    double r_end = 0;
+    const double hint = std::max(am1, room.max_rate_per_s2);
+    if (!coast_backup(r_, rd_, tau_, hint, landing, r_end)) return false;
+    RatePath shifted;
+    if (sg * (goal - r_end) > 0 && r_end <= kPlannedRate) {
+        shifted.add({0, (r_end - goal) / -rd_, false, -1});
+        for (int i = 0; i < landing.count; ++i)
+            shifted.add(landing.pieces[static_cast<std::size_t>(i)]);
+        RatePiece& last = shifted.pieces[static_cast<std::size_t>(shifted.count - 1)];
+        if (last.zero_rd) last.r_snap = goal;
+    }
+    for (RatePath* path : {&shifted, &landing}) {
+        if (path->count == 0 || path->count == RatePath::kMaxPieces || !rate_path_safe(*path))
+            continue;
+        RatePath head;
+        split_path(*path, dt, head);
+        cert_ = *path;
+        last_limits_ = {std::max(sg * rd_, rl_.max_rate_per_s), hint};
+        passed = apply_rate(head);
+        return true;
+    }
+    return false;
+}
+
+// Speeding up close to the goal, where the ramp's backup would land past it: the time-optimal
+// move onto the goal under `lim` (rate_path()), with the brake at lim's |r''| as its backup,
+// which lands on the goal (or short of it). Without it the landing coasts at the r' it has,
+// which near the goal can be small (it took 0.15 s at r' = 0.006 / s for the last 0.1 %).
+bool Sampler::approach(double goal, double dt, const RateLimits& lim, double& passed) noexcept {
+    RatePath move;
+    rate_path({r_, rd_}, goal, dt, lim, move);
+    RateState end{r_, rd_};
+    for (int i = 0; i < move.count; ++i) step_rate(end, move.pieces[static_cast<std::size_t>(i)]);
+    RatePath backup;
+    if (!brake_path(end, lim, backup) ||
+        end.r + end.rd * end.rd / (2 * lim.max_rate_per_s2) > goal + 1e-9)
+        return false;
+    RatePath whole = move;
+    for (int i = 0; i < backup.count; ++i) whole.add(backup.pieces[static_cast<std::size_t>(i)]);
+    if (whole.count >= RatePath::kMaxPieces || !rate_path_safe(whole)) return false;
+    cert_ = backup;
+    last_limits_ = lim;
+    passed = apply_rate(move);
+    return true;
 }
 
 double Sampler::apply_rate(const RatePath& path) noexcept {
@@ -824,7 +881,7 @@ Sampler::SignedRoom Sampler::signed_jerk_room(double from, double to, const Rate
     const double r_hi = std::max(box.r_hi, 0.0);
     RateSpan no_rdd = box;
     no_rdd.rdd = 0;
-    double up = kInf, down = kInf, up_min = 0, down_min = 0, rd_down = kInf;
+    double up = kInf, down = kInf, up_min = 0, down_min = 0, rd_down = kInf, rd_up = kInf;
     const Span r_span{std::max(box.r_lo, 0.0), r_hi};
     const Span r2_span = r_span * r_span;
     auto visit = [&](const PreparedSegment& rec, const ElementBounds& b, const AxisLimits& lim,
@@ -836,7 +893,7 @@ Sampler::SignedRoom Sampler::signed_jerk_room(double from, double to, const Rate
         const double free_a = 1 - (rec.rough ? js * r_hi : 0);
         const PathLoad load = path_load(pl, no_rdd);
         const double u = load.u.abs_max(), a_t = load.at.abs_max();
-        const double plan_at_lo = (pl.a * r2_span).lo;
+        const Span plan_at = pl.a * r2_span;
         const double u_lo = std::max(load.u.lo, 0.0);
         for (int q = 0; q < b.axis_count; ++q) {
             const int k = b.axes[q];
@@ -861,7 +918,8 @@ Sampler::SignedRoom Sampler::signed_jerk_room(double from, double to, const Rate
                 hi = (mj - 3 * u * a_t * b.g2[k] - u * u * u * b.g3[k]) / b.g1[k];
                 lo = -hi;
             }
-            rd_down = std::min(rd_down, (m_a + plan_at_lo) / v_hi);  // r' < 0: a_t >= -m_a
+            rd_down = std::min(rd_down, (m_a + plan_at.lo) / v_hi);  // r' < 0: a_t >= -m_a
+            rd_up = std::min(rd_up, (m_a - plan_at.hi) / v_hi);      // r' > 0: a_t <= m_a
             if (lim.jerk_mm_s3[k] <= 0) continue;
             up = std::min(up, (hi - load.jt.hi) / v_hi);
             down = std::min(down, (load.jt.lo - lo) / v_hi);
@@ -879,8 +937,9 @@ Sampler::SignedRoom Sampler::signed_jerk_room(double from, double to, const Rate
         up = std::min(up, beyond.max_rate_per_s2);
         down = std::min(down, beyond.max_rate_per_s2);
         rd_down = std::min(rd_down, beyond.max_rate_per_s);
+        rd_up = std::min(rd_up, beyond.max_rate_per_s);
     }
-    return {up, down, up_min, down_min, rd_down};
+    return {up, down, up_min, down_min, rd_down, rd_up};
 }
 
 // The first piece takes a quarter of r' (its check pairs r at its end with r' at its start, so

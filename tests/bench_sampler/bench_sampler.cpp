@@ -15,6 +15,10 @@
 //                                            if a run leaves the axis limits or does not finish.
 //   bench_sampler --holds                    how soon jerk-limited holds and override steps take
 //                                            effect (holds.cpp), on a simulated clock.
+//   bench_sampler --raises [--short] [--max-start-ms MS]
+//                                            how soon jerk-limited override increases take
+//                                            effect (raises.cpp); --short: the ctest grid;
+//                                            exits 1 if one starts rising later than MS.
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
@@ -32,6 +36,7 @@
 #include "motion/planner.hpp"
 #include "motion/sampler.hpp"
 #include "ngc_program.hpp"
+#include "raises.hpp"
 
 namespace {
 
@@ -172,6 +177,8 @@ void bm_period(benchmark::State& state, const CostCase& c) {
     if (c.mode == OverrideMode::Toggle30) {  // the periods in which the rate moved
         state.counters["changing_periods"] = static_cast<double>(changing_ns.size());
         report(changing_ns, "change_");
+        state.counters["rising_periods"] = static_cast<double>(rising_ns.size());
+        report(rising_ns, "rise_");
     }
 }
 
@@ -257,12 +264,28 @@ int digest_main(int argc, char** argv) {
     return ok ? 0 : 1;
 }
 
+int raises_main(int argc, char** argv) {
+    sampler_raises::Options opt;
+    for (int i = 2; i < argc; ++i) {
+        if (std::strcmp(argv[i], "--short") == 0) {
+            opt.short_grid = true;
+        } else if (std::strcmp(argv[i], "--max-start-ms") == 0 && i + 1 < argc) {
+            opt.max_start_ms = std::stod(argv[++i]);
+        } else {
+            fmt::print(stderr, "bench_sampler --raises: unknown argument '{}'\n", argv[i]);
+            return 2;
+        }
+    }
+    return sampler_raises::raises_main(opt);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     try {
         if (argc >= 2 && std::strcmp(argv[1], "--digest") == 0) return digest_main(argc, argv);
         if (argc == 2 && std::strcmp(argv[1], "--holds") == 0) return sampler_holds::holds_main();
+        if (argc >= 2 && std::strcmp(argv[1], "--raises") == 0) return raises_main(argc, argv);
         benchmark::Initialize(&argc, argv);
         if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
         register_cost_cases();

@@ -32,6 +32,8 @@ PathSegment circle(double radius_mm, int turns, double feed) {
     return s;
 }
 
+}  // namespace
+
 std::vector<PreparedSegment> plan(const PlannerConfig& cfg, const std::vector<PathSegment>& moves) {
     std::vector<PreparedSegment> recs;
     Planner p(cfg, {});
@@ -44,6 +46,8 @@ std::vector<PreparedSegment> plan(const PlannerConfig& cfg, const std::vector<Pa
     while (p.pop(r)) recs.push_back(r);
     return recs;
 }
+
+namespace {
 
 struct Run {
     // From the request to the first period in which the path decelerates as the jerk limit

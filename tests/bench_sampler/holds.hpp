@@ -1,7 +1,14 @@
 // bench_sampler --holds (holds.cpp): the table of jerk-limited hold and override response times.
 #pragma once
 
+#include <vector>
+
+#include "motion/planner.hpp"
+
 namespace sampler_holds {
+// The records a planner makes of `moves` (all of them, finished).
+std::vector<motion::PreparedSegment> plan(const motion::PlannerConfig& cfg,
+                                          const std::vector<motion::PathSegment>& moves);
 // Prints the table; 1 if a run left the axis limits or a hold never ended.
 int holds_main();
 // The shortest stop from path speed u0 and tangential acceleration a0 under |a| <= acc and

@@ -19,22 +19,27 @@
 //   limits over the part of every profile phase it covers (rate_path_safe(): per piece, the
 //   smaller of two bounds on a r^2 + v r' and j r^3 + 3 a r r' + v r'': the plan's peaks
 //   with the terms added, and the terms as signed ranges with an arc's perpendicular parts in
-//   quadrature, ranged_axis_peak()). While slowing below 1 other moves are tried first, each
-//   with a backup that brakes r' in pieces, each at the room of the stretch it covers,
-//   coasting while there is none as the falling rate makes room (coast_backup()): r'' against
-//   the plan's jerk (signed_jerk_room(): inside a jerk phase at r = 1 that side has nearly
-//   2 J, the other 1 %), or the least r'' that keeps the tangential jerk at -J, as long as
-//   that backup still lands at or above the target; else that landing itself. So a hold
-//   follows nearly the shortest jerk-limited stop. Otherwise the period follows the backup
+//   quadrature, ranged_axis_peak()). While slowing below 1, and while speeding up towards a
+//   rate of at most 1 (directed_moves()), other moves are tried first, each with a backup
+//   that brakes r' in pieces, each at the room of the stretch it covers, coasting while there
+//   is none as a falling rate makes room (coast_backup()): r'' of the sign of the change at
+//   the room the plan's jerk leaves on that side (signed_jerk_room(): inside a jerk phase at
+//   r = 1 the side against the plan's jerk has nearly 2 J, the other 1 %; in cruise J), or
+//   the least r'' that keeps the tangential jerk within the limit, as long as that backup
+//   still lands on the near side of the target; speeding up, near the target, the
+//   time-optimal move onto it at that room (approach()); else that landing itself. So a hold
+//   follows nearly the shortest jerk-limited stop, and a raise starts in the period it is
+//   asked for wherever the plan leaves room. Otherwise the period follows the backup
 //   accepted before (cert_), which stays valid because it was checked to its end. A rate held
 //   at r <= 1 is a pure time scale, which the plan keeps within (1 - reserve) of every limit,
 //   so the backup always ends safe; beyond the records in the ring only what the planner
 //   guarantees of every record is trusted (unknown_safe(): the fixed bounds at r = 1, more as r
 //   falls; rate_fits_any_record()). The rate then changes quickly where the plan leaves room
-//   (cruise, r < 1, slowing while the plan speeds up or against its jerk); slowing in a jerk
+//   (cruise, r < 1, changing against the plan's jerk or its acceleration); slowing in a jerk
 //   phase that ends an acceleration, the plan's own jerk already decelerates at the limit and
-//   the rate rides it (what the axis's jerk limit allows anyway); speeding up inside a jerk
-//   phase at r near 1 still waits for room (only slowing has the moves above).
+//   the rate rides it (what the axis's jerk limit allows anyway), and speeding up inside an
+//   acceleration at nearly the limit the rate can only creep until the plan leaves room
+//   (a r^2 + v r' within A). Above 1 only the symmetric proposal rises (the caps shape it).
 // Above r = 1 the per-phase rate caps of the records within reach shape the target, and the
 // checks above keep a r^2, j r^3 and v r within the limits. So any override in [0, max_rate],
 // any hold and any abort keeps every axis within its limits.
@@ -199,6 +204,11 @@ class Sampler {
         double start_s = 0;     // its start in the front record's planned time
     };
     double advance_rate_jerk(double target, double dt) noexcept;
+    // The directed moves towards `goal` (slowing, or speeding up to at most 1); true with the
+    // planned time passed when one was taken.
+    bool directed_moves(double goal, double dt, const RateLimits& room, double vm_acc,
+                        double& passed) noexcept;
+    bool approach(double goal, double dt, const RateLimits& lim, double& passed) noexcept;
     RateLimits jerk_room_limits(double target, double dt, double* vm_acc_out = nullptr) noexcept;
     bool rate_path_safe(const RatePath& path) noexcept;
     // The largest |r''| of each sign that keeps the tangential jerk j r^3 + 3 a r r' + v r''
@@ -210,6 +220,7 @@ class Sampler {
         double up = 0, down = 0;          // largest |r''| for r'' > 0 and for r'' < 0
         double up_min = 0, down_min = 0;  // least |r''| of that sign (0: r'' = 0 fits)
         double rd_down = 0;  // largest |r'| for r' < 0 that keeps the acceleration within A
+        double rd_up = 0;    // largest r' > 0 that keeps it within A
     };
     SignedRoom signed_jerk_room(double from, double to, const RateSpan& box, WalkFrom& at) noexcept;
     // The backup that brakes r' to 0 in pieces, each at the largest |r''| its own stretch
