@@ -615,6 +615,21 @@ bool Sampler::directed_moves(double goal, double dt, const RateLimits& room, dou
             return true;
         }
         if (!down && approach(goal, dt, {kRampShare * vm_move, am1}, passed)) return true;
+        if (!down && rd_ > 0) {
+            // Riding a room that shrinks as r grows (the acceleration's, or the backup's
+            // brake against the plan's jerk): r' let down at a quarter of the ramp's |r''|
+            // rather than a landing's whole brake and the ramp back the period after (which
+            // turned the path's jerk from +J to -0.9 J and back every other period).
+            RatePath ease;
+            const double u = 0.25 * am1;
+            const double h = std::min(dt, rd_ / u);
+            ease.add({-u, h, h < dt, -1});
+            if (h < dt) ease.add({0, dt - h, false, -1});
+            if (try_move(ease, am1)) {
+                passed = apply_rate(ease);
+                return true;
+            }
+        }
     } else if (sg * rd_ > 0) {
         RatePath move;
         const double u = least_brake * (1 + 1e-6);
@@ -981,14 +996,18 @@ bool Sampler::coast_backup(double r, double rd, double tau, double am_hint, Rate
         Span got{};
         for (int it = 0; it < 6 && pick < 0; ++it) {
             got = room_at(guess, frac, h);
-            if (got.hi < floor) break;
+            // Braking a rising r' (rd > 0) cannot coast (a rising rate makes no room): a
+            // stretch that needs more than it allows is cut shorter there too.
+            if (got.hi < floor && !(rd > 0 && got.lo > got.hi)) break;
             if (got.lo > got.hi) {  // a shorter piece: less of r', at least twice as fast
                 frac /= 2;
                 guess = std::max(2 * guess, got.hi);
             } else if (got.hi >= guess) {
                 pick = got.hi;
             } else {
-                guess = std::max(got.lo, it < 2 ? got.hi : 0.9 * got.hi);
+                // Braking a rising r' the room shrinks as the piece grows (the rate climbs
+                // into the plan's j r^3): a longer step, so it settles within the tries.
+                guess = std::max(got.lo, it < 2 ? got.hi : (rd > 0 ? 0.8 : 0.9) * got.hi);
             }
         }
         if (pick < 0) {

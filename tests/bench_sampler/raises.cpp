@@ -12,6 +12,9 @@
 //   axis's), or, where the plan barely moves (v r' stays small however fast r rises), r rises
 //   by 1 % of the step in one period, or the rate is at its target;
 // - "there after": from the request to the rate at its target;
+// - jerk reversals: periods in which the path's jerk turned from above J / 4 to below -J / 4
+//   or back, from the request to the target (a smoothness figure: each is a jerk step of at
+//   least J / 2 from one period to the next);
 // - on the straight line, a lower bound for "there" (lower_bound_s()) and the excess over it,
 //   also apart for the raises whose rate meets the plan in its cruise, where the bound is the
 //   time-optimal jerk-limited speed change and so close to what is possible; earlier it only
@@ -125,6 +128,7 @@ struct Rise {
     double start_s = -1;  // rising after
     double done_s = -1;   // at the target after
     bool ok = true;       // within the limits throughout
+    int reversals = 0;    // periods whose path jerk turned from above J / 4 to below -J / 4 or back
     double s0 = 0, u0 = 0, a0 = 0;
 };
 
@@ -155,11 +159,22 @@ Rise play(const PlannerConfig& cfg, const std::vector<PreparedSegment>& recs, lo
         for (int k = 0; k < kAxes; ++k) u2 += m.vel_mm_s[k] * m.vel_mm_s[k];
         return std::sqrt(u2);
     };
+    auto path_jerk = [&](const MotionSample& m) {
+        const double u = speed(m);
+        double uj = 0;
+        for (int k = 0; k < kAxes; ++k) uj += m.vel_mm_s[k] * m.jerk_mm_s3[k];
+        return u > 0 ? uj / u : 0.0;
+    };
+    double j_prev = path_jerk(last);
     for (long n = 1; n <= 20000 && !sampler.status().done; ++n) {
         step();
         const double rate = sampler.status().rate;
         const bool there = rate >= after - 1e-9;
         const double v = rate > 0 ? speed(last) / rate : 0;
+        const double j_now = path_jerk(last);
+        if ((j_prev > jerk / 4 && j_now < -jerk / 4) || (j_prev < -jerk / 4 && j_now > jerk / 4))
+            ++out.reversals;
+        j_prev = j_now;
         if (out.start_s < 0 && (there || v * (rate - r_prev) / kDt_s >= jerk * kDt_s / 8 ||
                                 rate - r_prev >= 0.01 * (after - before)))
             out.start_s = n * kDt_s;
@@ -204,7 +219,7 @@ struct Verdict {
 void sweep(const std::string& name, const PlannerConfig& cfg,
            const std::vector<PreparedSegment>& recs, long from_ms, long to_ms, long step_ms,
            double before, double after, const LineTable* line, Verdict& verdict) {
-    Stats start, done, bound, excess, excess_cruise;
+    Stats start, done, bound, excess, excess_cruise, reversals;
     int bad = 0, count = 0;
     for (long at = from_ms; at <= to_ms; at += step_ms) {
         const Rise run = play(cfg, recs, at, before, after);
@@ -235,13 +250,15 @@ void sweep(const std::string& name, const PlannerConfig& cfg,
                 }
             }
         }
+        reversals.add(run.reversals, at);
         if (!run.ok) ++bad;
     }
     if (bad || done.missing || start.missing) verdict.ok = false;
-    fmt::print("| {} ({} raises) | {} | {} | {} | {} | {} |{}\n", name, count, start.text(),
-               done.text(true), bound.text(), excess.text(true),
+    fmt::print("| {} ({} raises) | {} | {} | {} | {} | {} | {:.1f} ({:g}) |{}\n", name, count,
+               start.text(), done.text(true), bound.text(), excess.text(true),
                excess_cruise.n ? fmt::format("{} ({})", excess_cruise.text(true), excess_cruise.n)
                                : std::string("-"),
+               reversals.mean, reversals.hi,
                bad ? fmt::format(" LIMITS LEFT in {} runs", bad) : "");
 }
 
@@ -287,8 +304,8 @@ int raises_main(const Options& opt) {
     fmt::print(
         "| case | rising after, s: mean (range) | at the target after, s | lower bound, s | "
         "after less the bound, s | the same where the rate meets the plan in its cruise (raises) "
-        "|\n");
-    fmt::print("|---|---|---|---|---|---|\n");
+        "| path jerk reversals per raise: mean (most) |\n");
+    fmt::print("|---|---|---|---|---|---|---|\n");
     Verdict verdict;
     const std::vector<double> jerks =
         opt.short_grid ? std::vector<double>{1e4} : std::vector<double>{1e4, 1e5};
@@ -302,7 +319,7 @@ int raises_main(const Options& opt) {
         };
         const std::vector<Step> steps =
             opt.short_grid ? std::vector<Step>{{0.4, 1}}
-                           : std::vector<Step>{{0.4, 1}, {0.1, 1}, {0.7, 1}, {0.4, 0.8}};
+                           : std::vector<Step>{{0.4, 1}, {0.1, 1}, {0.7, 1}, {0.9, 1}, {0.4, 0.8}};
         const long every = opt.short_grid ? 10 : 5;
         for (const Step& st : steps) {
             // Over the acceleration from rest (at the `before` rate it lasts accel / before)
