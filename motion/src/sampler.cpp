@@ -996,9 +996,7 @@ bool Sampler::coast_backup(double r, double rd, double tau, double am_hint, Rate
         Span got{};
         for (int it = 0; it < 6 && pick < 0; ++it) {
             got = room_at(guess, frac, h);
-            // Braking a rising r' (rd > 0) cannot coast (a rising rate makes no room): a
-            // stretch that needs more than it allows is cut shorter there too.
-            if (got.hi < floor && !(rd > 0 && got.lo > got.hi)) break;
+            if (got.hi < floor) break;
             if (got.lo > got.hi) {  // a shorter piece: less of r', at least twice as fast
                 frac /= 2;
                 guess = std::max(2 * guess, got.hi);
