@@ -15,6 +15,9 @@
 //                                            if a run leaves the axis limits or does not finish.
 //   bench_sampler --holds                    how soon jerk-limited holds and override steps take
 //                                            effect (holds.cpp), on a simulated clock.
+//   bench_sampler --worst PROGRAM...         the dearest single period (jerk 1e5, toggling
+//                                            100 <-> 30 %), each period's least CPU time over
+//                                            seven identical runs, so the load counts less.
 //   bench_sampler --raises [--short] [--max-start-ms MS]
 //                                            how soon jerk-limited override increases take
 //                                            effect (raises.cpp); --short: the ctest grid;
@@ -185,9 +188,8 @@ void bm_period(benchmark::State& state, const CostCase& c) {
 void register_cost_cases() {
     for (const char* program : {"surface_3d.ngc", "tangent_arcs.ngc"})
         for (double jerk : {0.0, kJerkLimited_mm_s3})
-            for (OverrideMode mode :
-                 {OverrideMode::At100, OverrideMode::At120, OverrideMode::Toggle,
-                  OverrideMode::Toggle30}) {
+            for (OverrideMode mode : {OverrideMode::At100, OverrideMode::At120,
+                                      OverrideMode::Toggle, OverrideMode::Toggle30}) {
                 const std::string name =
                     fmt::format("period/{}/jerk:{:g}/override:{}", program, jerk, mode_name(mode));
                 benchmark::RegisterBenchmark(name.c_str(), bm_period, CostCase{program, jerk, mode})
@@ -256,12 +258,76 @@ int digest_main(int argc, char** argv) {
     for (int i = 2; i < argc; ++i) {
         const bench::BenchProgram prog = bench::read_program(argv[i], kTolerance_mm);
         for (double jerk : {0.0, kJerkLimited_mm_s3})
-            for (OverrideMode mode :
-                 {OverrideMode::At100, OverrideMode::At120, OverrideMode::Toggle,
-                  OverrideMode::Toggle30})
+            for (OverrideMode mode : {OverrideMode::At100, OverrideMode::At120,
+                                      OverrideMode::Toggle, OverrideMode::Toggle30})
                 ok = digest_run(argv[i], prog, jerk, mode) && ok;
     }
     return ok ? 0 : 1;
+}
+
+// --worst: the dearest single period with the machine's noise taken out. The same 12 000
+// periods (fixed program, jerk 1e5 mm/s^3, override toggling 100 <-> 30 %) are played kRuns
+// times; each period's figure is its least CPU time over the runs (a preemption or a cold
+// cache in one run does not count), and the table gives the largest of those, with the means
+// over the periods in which the rate rose and fell.
+int worst_main(int argc, char** argv) {
+    constexpr int kRuns = 7;
+    constexpr long kPeriods = 4 * kTogglePeriods;
+    for (int i = 2; i < argc; ++i) {
+        const PlannerConfig cfg = config_for(kJerkLimited_mm_s3);
+        const bench::BenchProgram prog = bench::read_program(argv[i], kTolerance_mm);
+        const std::vector<PreparedSegment> recs = bench::plan_all(cfg, prog);
+        const double overhead_ns = cpu_clock_overhead_ns();
+        std::vector<double> least(kPeriods, 1e300);
+        std::vector<int> change(kPeriods, 0);  // +1 rose, -1 fell
+        for (int run = 0; run < kRuns; ++run) {
+            Feeder feeder(recs);
+            SpscRing<PreparedSegment> ring(1024);
+            feeder.top_up(ring);
+            Sampler sampler(sampler_config(cfg), ring, prog.start_mm);
+            for (long p = 0; p < kPeriods; ++p) {
+                feeder.top_up(ring);
+                sampler.set_feed_override(override_at(OverrideMode::Toggle30, p));
+                const double before = sampler.status().rate;
+                const double c0 = thread_cpu_ns();
+                const MotionSample ms = sampler.advance(kPeriod_s);
+                const double c1 = thread_cpu_ns();
+                benchmark::DoNotOptimize(ms);
+                const std::size_t k = static_cast<std::size_t>(p);
+                least[k] = std::min(least[k], std::max(0.0, c1 - c0 - overhead_ns));
+                const double after = sampler.status().rate;
+                change[k] = after > before ? 1 : after < before ? -1 : 0;
+            }
+        }
+        double worst = 0, rise_sum = 0, fall_sum = 0, rise_worst = 0, fall_worst = 0;
+        long worst_at = 0, rises = 0, falls = 0;
+        for (std::size_t k = 0; k < least.size(); ++k) {
+            if (least[k] > worst) {
+                worst = least[k];
+                worst_at = static_cast<long>(k);
+            }
+            if (change[k] > 0) {
+                rise_sum += least[k];
+                rise_worst = std::max(rise_worst, least[k]);
+                ++rises;
+            } else if (change[k] < 0) {
+                fall_sum += least[k];
+                fall_worst = std::max(fall_worst, least[k]);
+                ++falls;
+            }
+        }
+        fmt::print(
+            "{}: least of {} runs per period, us: dearest period {:.1f} (period {}, {}); rising "
+            "{} periods, mean {:.2f}, dearest {:.1f}; falling {} periods, mean {:.2f}, dearest "
+            "{:.1f}\n",
+            argv[i], kRuns, worst / 1e3, worst_at,
+            change[static_cast<std::size_t>(worst_at)] > 0   ? "rising"
+            : change[static_cast<std::size_t>(worst_at)] < 0 ? "falling"
+                                                             : "steady",
+            rises, rises ? rise_sum / rises / 1e3 : 0.0, rise_worst / 1e3, falls,
+            falls ? fall_sum / falls / 1e3 : 0.0, fall_worst / 1e3);
+    }
+    return 0;
 }
 
 int raises_main(int argc, char** argv) {
@@ -286,6 +352,7 @@ int main(int argc, char** argv) {
         if (argc >= 2 && std::strcmp(argv[1], "--digest") == 0) return digest_main(argc, argv);
         if (argc == 2 && std::strcmp(argv[1], "--holds") == 0) return sampler_holds::holds_main();
         if (argc >= 2 && std::strcmp(argv[1], "--raises") == 0) return raises_main(argc, argv);
+        if (argc >= 3 && std::strcmp(argv[1], "--worst") == 0) return worst_main(argc, argv);
         benchmark::Initialize(&argc, argv);
         if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
         register_cost_cases();
