@@ -27,7 +27,8 @@
 //   r = 1 the side against the plan's jerk has nearly 2 J, the other 1 %; in cruise J), or
 //   the least r'' that keeps the tangential jerk within the limit, as long as that backup
 //   still lands on the near side of the target; speeding up, near the target, the
-//   time-optimal move onto it at that room (approach()); else that landing itself. So a hold
+//   time-optimal move onto it at that room (approach()), and where the ramp's backup no
+//   longer fits r' let down at a quarter of its r''; else that landing itself. So a hold
 //   follows nearly the shortest jerk-limited stop, and a raise starts in the period it is
 //   asked for wherever the plan leaves room. Otherwise the period follows the backup
 //   accepted before (cert_), which stays valid because it was checked to its end. A rate held
