@@ -581,10 +581,6 @@ struct Stretch {
     double length_mm, vcap_mm_s, acc_mm_s2;
 };
 
-// Time to run the stretches in turn, entering at v_in_mm_s and leaving at v_out_mm_s (or as
-// fast as the caps allow there), each at the fastest trapezoid the junction speeds leave it:
-// the planner's passes (plan_and_emit) on a few elements, to compare two ways of cutting one
-// corner.
 // std::sqrt(x2) where x2 may be x * x for the x >= 0 it was made from, unchanged: then that
 // root is x itself, and taking it (a long-latency instruction on the estimate's critical path)
 // is skipped. In binary floating point with rounding to nearest the square root of the rounded
@@ -597,6 +593,10 @@ double root_of_square(double x2, double x) {
     return std::sqrt(x2);
 }
 
+// Time to run the stretches in turn, entering at v_in_mm_s and leaving at v_out_mm_s (or as
+// fast as the caps allow there), each at the fastest trapezoid the junction speeds leave it:
+// the planner's passes (plan_and_emit) on a few elements, to compare two ways of cutting one
+// corner.
 template <std::size_t N>
 double local_time_s(const std::array<Stretch, N>& st, double v_in_mm_s, double v_out_mm_s) {
     // Junction speeds squared: the passes need no roots. x: each one before the passes, whose
