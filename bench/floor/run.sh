@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # The numerical floor (bench/floor/floor.py) on tp_default's sections where LinuxCNC leaves the
 # path (docs/benchmarks.md, "A numerical floor for sections"). Installs python3-scipy if it is
-# missing, like scripts/deps.sh. Extra arguments go to every floor.py call (e.g. --step-ms 1).
-#   bench/floor/run.sh                 # all sections, 2 ms grid
-#   bench/floor/run.sh --step-ms 1     # 1 ms grid (slower, tighter)
+# missing, like scripts/deps.sh. Extra arguments go to every floor.py call (the last of a
+# repeated option counts, e.g. --time-limit 600).
+#   bench/floor/run.sh
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
@@ -15,16 +15,21 @@ if ! dpkg-query -W -f='${Status}' python3-scipy 2>/dev/null | grep -q "install o
   DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends python3-scipy
 fi
 program="$root/bench/tp_default.ngc"
-# Sections: the three row ends, the rapids between the rows and the half circles, the last
-# four moves. The row ends take the rows' 0.5 mm chains as hulls (--group-deg 10).
+# Sections: the three row ends, the rapids between the rows and the half circles, and the last
+# four moves split at their corners (floors of sections disjoint in time add up). The row ends
+# take the rows' 0.5 mm chains as hulls (--group-deg 10). The horizons are a little above our
+# planner's times, so the bisection starts close. These are the commands of the table in
+# docs/benchmarks.md; on this 2-vCPU VM they take about an hour together.
 sections=(
-  "201-209 --group-deg 10"
-  "401-410 --group-deg 10"
-  "603-611 --group-deg 10"
-  "807-810"
-  "831-834"
+  "201-209 --group-deg 10 --step-ms 2 --lead-in 15 --lead-out 15 --horizon-ms 264 --time-limit 150"
+  "401-410 --group-deg 10 --step-ms 2 --lead-in 15 --lead-out 15 --horizon-ms 280 --time-limit 200"
+  "603-611 --group-deg 10 --step-ms 2 --lead-in 15 --lead-out 15 --horizon-ms 262 --time-limit 150"
+  "807-810 --step-ms 2 --lead-in 15 --lead-out 15 --horizon-ms 904 --time-limit 200"
+  "831-831 --step-ms 1 --lead-in 25 --lead-out 25 --horizon-ms 486 --time-limit 200"
+  "832-832 --step-ms 2 --lead-in 15 --lead-out 15 --horizon-ms 1560 --time-limit 200"
+  "833-834 --step-ms 1 --lead-in 25 --lead-out 25 --horizon-ms 828 --time-limit 200"
 )
 for s in "${sections[@]}"; do
   # shellcheck disable=SC2086
-  /usr/bin/python3 "$here/floor.py" "$program" --lines $s --step-ms 2 "$@"
+  /usr/bin/python3 "$here/floor.py" "$program" --lines $s "$@"
 done

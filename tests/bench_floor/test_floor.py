@@ -164,6 +164,11 @@ class TestFloor(unittest.TestCase):
         self._trace_is_feasible("G21 G90 G64 P0.02\nG1 X3 Y1 Z-1 F4000\nG1 X3.5 Y3 Z0\n"
                                 "G0 X0 Y0 Z1\nM2\n")
 
+    def test_planner_trace_satisfies_the_relaxation_around_an_arc(self):
+        # A half circle (its hull rows and the arc's feed, 40 mm/s) between two lines, as
+        # before tp_default's line 831.
+        self._trace_is_feasible("G21 G90\nG1 X2 F2400\nG3 X7 Y0 I2.5 J0\nG1 Y4 F4000\nM2\n")
+
     def test_floor_is_below_the_planner_on_a_short_u_turn(self):
         # The bisection itself: its floor may not exceed the time of a real motion.
         prog = "G21 G90\nG1 X3 F3000\nG1 Y0.5\nG1 X0\nM2\n"
