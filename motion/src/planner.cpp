@@ -384,22 +384,26 @@ bool Planner::bezier_corner(const Piece& p, const Piece& next, double sin_angle,
     // usually just under the two-line value: 0.974 of it on ex23's 90 degree arc-line corners),
     // then by 0.7; after a 0.7 step bisect back towards the cut that failed, as the corner speed
     // grows with the square root of the cut.
-    Fit fit, trial;
+    // The cut proved last is tried[best]; a trial writes into the other one, which becomes best
+    // when it is proved (copying a Fit, 864 bytes, was a rep movs).
+    std::array<Fit, 2> tried;
+    int best = 0;
     double l_fail = 0;  // a cut that was tried and not proved
     bool found = false;
     for (int attempt = 0; attempt < kBlendAttempts && l > kMinLength_mm; ++attempt) {
-        if ((found = fits(l, fit))) break;
+        if ((found = fits(l, tried[best]))) break;
         l_fail = l;
         l *= attempt == 0 ? kBlendFirstShrink : 0.7;
     }
     if (!found) return false;
     for (int i = 0; i < kBlendBisections && l_fail > l / kBlendFirstShrink * (1 + 1e-9); ++i) {
         double mid = std::sqrt(l * l_fail);
-        if (fits(mid, trial))
-            l = mid, fit = trial;
+        if (fits(mid, tried[1 - best]))
+            l = mid, best = 1 - best;
         else
             l_fail = mid;
     }
+    const Fit& fit = tried[best];
     const CurvePoint &a = fit.a, &b = fit.b;
     jn.set(kInf, false, l, Blend::Curve);
     make_corner_bezier(fit.ctrl, path, jn.curve);
