@@ -511,7 +511,7 @@ class SectionModel:
         return win
 
     # -- the MILP ---------------------------------------------------------------------------
-    def solve(self, time_limit_s=120.0, verbose=False, hull=True, feasibility=False,
+    def solve(self, time_limit_s=120.0, verbose=False, feasibility=False,
               fixed=None, fixed_tol_mm=0.0, assignment=None):
         """The MILP for this horizon. feasibility=True drops the objective: HiGHS then stops
         at the first solution, and a proof of infeasibility shows t_b - t_a >= U h.
@@ -599,7 +599,7 @@ class SectionModel:
         # Tubes: sample k on move i (z_(k,i-1) = 1, z_(k,i) = 0) is within P_i of it.
         for k in ks:
             if k != 0:
-                self._tube_rows(k, win[k], qidx[k], zval, vp, cons, hull)
+                self._tube_rows(k, win[k], qidx[k], zval, vp, cons)
         # The assignment is monotone: z_(k,v) >= z_(k,v+1) and z_(k+1,v) >= z_(k,v).
         after = dict(zip(ks, ks[1:]))
         for (k, v), var in zidx.items():
@@ -657,10 +657,10 @@ class SectionModel:
         return FloorResult(proved * h, status, proved, relaxed, gap, solve_s, h, self.U * h,
                            vp.count, len(zidx), len(cons.lo), traj)
 
-    def _tube_rows(self, k, window, q, zval, vp, cons, hull):
-        """Sample k lies within P_i of the move i it is on. With hull=True as the convex hull
-        of the disjunction (q_k = sum of q_k^i, q_k^i in y_i times move i's polytope, y_i = 1
-        on the move the sample is on), which is a much tighter LP than big-M."""
+    def _tube_rows(self, k, window, q, zval, vp, cons):
+        """Sample k lies within P_i of the element i it is on, written as the convex hull of
+        the disjunction (q_k = sum of q_k^i, q_k^i in y_i times element i's polytope, y_i = 1
+        on the element the sample is on): a tighter LP than big-M rows."""
         lo, hi = window
         if lo == hi:
             for n, r in self.el_rows(lo):
@@ -677,29 +677,18 @@ class SectionModel:
             if not y_terms and y_const <= 0.0:
                 continue
             parts.append((i, y_const, y_terms))
-        if hull:
-            sums = [[(q + j, 1.0)] for j in range(3)]
-            for i, y_const, y_terms in parts:
-                qi = vp.add(3)
-                for j in range(3):
-                    sums[j].append((qi + j, -1.0))
-                for n, r in self.el_rows(i):
-                    rr = r + SLACK
-                    # n . q^i <= rr * y_i
-                    coefs = _dot(qi, n) + [(var, -rr * c) for var, c in y_terms]
-                    cons.add(coefs, -np.inf, rr * y_const)
-            for j in range(3):
-                cons.add(sums[j], 0.0, 0.0)
-            return
+        sums = [[(q + j, 1.0)] for j in range(3)]
         for i, y_const, y_terms in parts:
+            qi = vp.add(3)
+            for j in range(3):
+                sums[j].append((qi + j, -1.0))
             for n, r in self.el_rows(i):
-                big = sum(max(n[j] * vp.lo[q + j], n[j] * vp.hi[q + j]) for j in range(3)) - r
-                if big <= 0:
-                    continue
-                big += SLACK
-                # n . q <= r + big (1 - y_i)
-                coefs = _dot(q, n) + [(var, big * c) for var, c in y_terms]
-                cons.add(coefs, -np.inf, r + SLACK + big * (1.0 - y_const))
+                rr = r + SLACK
+                # n . q^i <= rr * y_i
+                coefs = _dot(qi, n) + [(var, -rr * c) for var, c in y_terms]
+                cons.add(coefs, -np.inf, rr * y_const)
+        for j in range(3):
+            cons.add(sums[j], 0.0, 0.0)
 
     def _feed_rows(self, k0, k1, win, qidx, zval, vp, cons):
         ea, h, lim = self.ea, self.h, self.lim
