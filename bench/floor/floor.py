@@ -512,12 +512,13 @@ class SectionModel:
 
     # -- the MILP ---------------------------------------------------------------------------
     def solve(self, time_limit_s=120.0, verbose=False, feasibility=False,
-              fixed=None, fixed_tol_mm=0.0, assignment=None):
+              fixed=None, fixed_tol_mm=0.0, assignment=None, mps_path=None):
         """The MILP for this horizon. feasibility=True drops the objective: HiGHS then stops
         at the first solution, and a proof of infeasibility shows t_b - t_a >= U h.
         fixed: {k: xyz} pins samples (within fixed_tol_mm) to a given motion, to test that a
         real motion satisfies every row; assignment: {k: element} pins the samples' elements
-        as well (for tests and debugging)."""
+        as well (for tests and debugging). mps_path: write the MILP there in free MPS format
+        (for a second solver, e.g. `cbc FILE solve`) instead of solving it."""
         t_start = time.monotonic()
         a, h, lim = self.a, self.h, self.lim
         ea, eb = self.ea, self.eb
@@ -630,7 +631,11 @@ class SectionModel:
                     cost[z] -= 1.0
                     const += 1.0
         A = cons.matrix(vp.count)
-        res = milp(np.zeros(vp.count) if feasibility else cost, integrality=np.array(vp.integer, float),
+        if mps_path is not None:
+            write_mps(mps_path, np.zeros(vp.count) if feasibility else cost, vp, A, cons)
+            return None
+        res = milp(np.zeros(vp.count) if feasibility else cost,
+                   integrality=np.array(vp.integer, float),
                    bounds=Bounds(np.array(vp.lo), np.array(vp.hi)),
                    constraints=LinearConstraint(A, np.array(cons.lo), np.array(cons.hi)),
                    options={"time_limit": time_limit_s, "mip_rel_gap": 0.0, "disp": verbose,
@@ -776,6 +781,53 @@ class _Rows:
         return coo_matrix((self.v, (self.i, self.j)), shape=(len(self.lo), ncols)).tocsr()
 
 
+def write_mps(path, cost, vp, A, cons):
+    """The MILP in free MPS: rows r0.., columns x0.., integers between markers."""
+    with open(path, "w") as f:
+        f.write("NAME floor\nROWS\n N obj\n")
+        kinds = []
+        for r, (lo, hi) in enumerate(zip(cons.lo, cons.hi)):
+            kind = "E" if lo == hi else "L" if math.isfinite(hi) else "G"
+            kinds.append(kind)
+            f.write(f" {kind} r{r}\n")
+        f.write("COLUMNS\n")
+        csc = A.tocsc()
+        in_int = False
+        for j in range(csc.shape[1]):
+            if vp.integer[j] != in_int:
+                f.write(f" M{j} 'MARKER' '{'INTORG' if vp.integer[j] else 'INTEND'}'\n")
+                in_int = bool(vp.integer[j])
+            if cost[j] != 0.0:
+                f.write(f" x{j} obj {cost[j]!r}\n")
+            for k in range(csc.indptr[j], csc.indptr[j + 1]):
+                f.write(f" x{j} r{csc.indices[k]} {csc.data[k]!r}\n")
+            if csc.indptr[j] == csc.indptr[j + 1] and cost[j] == 0.0:
+                f.write(f" x{j} obj 0\n")
+        if in_int:
+            f.write(" Mend 'MARKER' 'INTEND'\n")
+        f.write("RHS\n")
+        for r, kind in enumerate(kinds):
+            rhs = cons.hi[r] if kind in ("L", "E") else cons.lo[r]
+            if rhs != 0.0:
+                f.write(f" rhs r{r} {rhs!r}\n")
+        f.write("RANGES\n")
+        for r, kind in enumerate(kinds):
+            if kind == "L" and math.isfinite(cons.lo[r]):
+                f.write(f" rng r{r} {cons.hi[r] - cons.lo[r]!r}\n")
+        f.write("BOUNDS\n")
+        for j, (lo, hi) in enumerate(zip(vp.lo, vp.hi)):
+            if lo == hi:
+                f.write(f" FX bnd x{j} {lo!r}\n")
+                continue
+            if not math.isfinite(lo) and not math.isfinite(hi):
+                f.write(f" FR bnd x{j}\n")
+                continue
+            f.write(f" LO bnd x{j} {lo!r}\n" if math.isfinite(lo) else f" MI bnd x{j}\n")
+            if math.isfinite(hi):
+                f.write(f" UP bnd x{j} {hi!r}\n")
+        f.write("ENDATA\n")
+
+
 def _dot(first_var, n):
     return [(first_var + j, float(n[j])) for j in range(3) if n[j] != 0.0]
 
@@ -888,6 +940,9 @@ def main():
     ap.add_argument("--prove-ms", type=float, default=None,
                     help="only try to prove t_b - t_a >= this (one feasibility MILP at this "
                     "horizon, e.g. with a longer --time-limit after a bisection)")
+    ap.add_argument("--export-mps", metavar="FILE",
+                    help="with --prove-ms: write that MILP in free MPS format instead of "
+                    "solving it (to check a proof with another solver: cbc FILE solve)")
     ap.add_argument("--presolve", action="store_true",
                     help="use HiGHS's presolve (faster, but HiGHS 1.2's once declared a real "
                     "motion infeasible: not for proofs)")
@@ -906,6 +961,11 @@ def main():
             model = make_model(moves, a, b, args.vmax, args.amax, args.step_ms, args.lead_in,
                                args.lead_out, args.prove_ms * 1e-3, args.perp, args.group_deg)
             model.presolve = args.presolve
+            if args.export_mps:
+                model.solve(feasibility=True, mps_path=args.export_mps)
+                print(f"lines {first}-{last}, horizon {model.U * model.h * 1e3:.0f} ms: "
+                      f"written to {args.export_mps}")
+                return
             res = model.solve(args.time_limit, args.verbose, feasibility=True)
             verdict = {"infeasible in horizon": f"proved: t_b - t_a >= {model.U * model.h:.3f} s",
                        "feasible": "not proved: the relaxation has a motion this fast",
