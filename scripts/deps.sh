@@ -21,7 +21,6 @@ packages=(
   libcairo2-dev
   libexpat1-dev
   python3-scipy
-  coinor-cbc
 )
 missing=()
 for p in "${packages[@]}"; do
