@@ -136,17 +136,6 @@ Run play(const PlannerConfig& cfg, const std::vector<PreparedSegment>& recs, lon
     return out;
 }
 
-// When the plan of `recs` first reaches `v_mm_s` (path speed), in ms.
-long reaches_ms(const std::vector<PreparedSegment>& recs, double v_mm_s) {
-    double start = 0;
-    for (const PreparedSegment& r : recs) {
-        for (double t = 0; t < r.profile.duration_s; t += 1e-4)
-            if (r.profile.at(t).v_mm_s >= v_mm_s * (1 - 1e-6)) return long((start + t) * 1000);
-        start += r.profile.duration_s;
-    }
-    return long(start * 1000);
-}
-
 struct Stats {
     double mean = 0, lo = 1e9, hi = 0;
     int n = 0, missing = 0;
@@ -264,6 +253,16 @@ int holds_main() {
     }
     fmt::print("{}\n", g_ok ? "all runs within the limits" : "FAILED: limits left or never held");
     return g_ok ? 0 : 1;
+}
+
+long reaches_ms(const std::vector<motion::PreparedSegment>& recs, double v_mm_s) {
+    double start = 0;
+    for (const motion::PreparedSegment& r : recs) {
+        for (double t = 0; t < r.profile.duration_s; t += 1e-4)
+            if (r.profile.at(t).v_mm_s >= v_mm_s * (1 - 1e-6)) return long((start + t) * 1000);
+        start += r.profile.duration_s;
+    }
+    return long(start * 1000);
 }
 
 }  // namespace sampler_holds

@@ -14,4 +14,7 @@ int holds_main();
 // The shortest stop from path speed u0 and tangential acceleration a0 under |a| <= acc and
 // |jerk| <= jerk (at rest with a = 0): a lower bound for any hold from that state.
 double shortest_stop_s(double u0, double a0, double acc, double jerk);
+// When the plan of `recs` first reaches path speed `v_mm_s`, in ms of planned time (searched
+// in 0.1 ms steps); the plan's whole length if it never does.
+long reaches_ms(const std::vector<motion::PreparedSegment>& recs, double v_mm_s);
 }  // namespace sampler_holds

@@ -262,17 +262,6 @@ void sweep(const std::string& name, const PlannerConfig& cfg,
                bad ? fmt::format(" LIMITS LEFT in {} runs", bad) : "");
 }
 
-// When the plan of `recs` first reaches `v_mm_s` (path speed), in ms of planned time.
-long reaches_ms(const std::vector<PreparedSegment>& recs, double v_mm_s) {
-    double start = 0;
-    for (const PreparedSegment& r : recs) {
-        for (double t = 0; t < r.profile.duration_s; t += 1e-4)
-            if (r.profile.at(t).v_mm_s >= v_mm_s * (1 - 1e-6)) return long((start + t) * 1000);
-        start += r.profile.duration_s;
-    }
-    return long(start * 1000);
-}
-
 // The line - quarter arc - line plan of SamplerJerk.OverrideStepsAtEveryPointOfThePlan…, its
 // jerk limits scaled to `jerk` (Y weaker: 600 mm/s^2, 0.4 of the jerk).
 PlannerConfig line_arc_line_cfg(double jerk) {
@@ -313,7 +302,7 @@ int raises_main(const Options& opt) {
         const PlannerConfig cfg = uniform(100, 1000, jerk);
         const auto line = sampler_holds::plan(cfg, {feed_to(200, 100, 0)});
         const LineTable table = line_table(line);
-        const long accel_ms = reaches_ms(line, 100);
+        const long accel_ms = sampler_holds::reaches_ms(line, 100);
         struct Step {
             double before, after;
         };
@@ -331,7 +320,7 @@ int raises_main(const Options& opt) {
         }
         if (!opt.short_grid) {
             const auto slow = sampler_holds::plan(cfg, {feed_to(200, 80, 0)});
-            const long to_ms = reaches_ms(slow, 80) + 50;
+            const long to_ms = sampler_holds::reaches_ms(slow, 80) + 50;
             sweep(fmt::format("J {:g}: line at 80 mm/s, 100 % -> 120 %, every 5 ms of the first "
                               "{} ms",
                               jerk, to_ms),
