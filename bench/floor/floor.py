@@ -21,12 +21,15 @@ refused with FILE:LINE and the cause.
 """
 import argparse
 import math
-import re
 import sys
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # bench/ngc_words.py
+from ngc_words import words_of  # noqa: E402
 
 try:
     from scipy.optimize import Bounds, LinearConstraint, linprog, milp
@@ -70,7 +73,6 @@ class Move:
 # ----------------------------------------------------------------------------------------------
 # Reading the program subset
 
-WORD = re.compile(r"([A-Za-z])\s*([-+]?(?:\d+\.?\d*|\.\d+))")
 MODAL_OK = {17, 21, 90, 64}
 
 
@@ -82,16 +84,15 @@ def parse_program(path, default_tol_mm=0.01, start=(0.0, 0.0, 0.0)):
     with open(path) as f:
         for number, text in enumerate(f, 1):
             where = f"{path}:{number}"
-            clean = re.sub(r"\(.*?\)|;.*", "", text).strip()
-            if not clean:
+            try:
+                words = words_of(text)
+            except ValueError as e:
+                raise ProgramError(f"{where}: {e}") from None
+            if not words:
                 continue
-            words = WORD.findall(clean)
-            if "".join(l + v for l, v in words) != re.sub(r"\s", "", clean):
-                raise ProgramError(f"{where}: cannot read '{clean}'")
             target, ij, new_mode, axes, p_word, ended = pos.copy(), [0.0, 0.0], None, False, None, False
             g64 = False
-            for letter, value in words:
-                letter, v = letter.upper(), float(value)
+            for letter, v, value in words:
                 if letter == "G":
                     if v in (0, 1, 2, 3):
                         new_mode = int(v)

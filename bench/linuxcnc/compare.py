@@ -20,10 +20,12 @@ G64 M2 M30; anything else is refused with the line that has it.
 """
 import argparse
 import math
-import re
 import sys
+from pathlib import Path
 
-WORD = re.compile(r"([A-Za-z])\s*([-+]?(?:\d+\.?\d*|\.\d+))")
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))  # bench/ngc_words.py
+from ngc_words import words_of  # noqa: E402
+
 IGNORED_G = {17, 21, 90, 64, 40, 49, 80, 94}
 # A sample this close to a move's end (along it) may be placed on the moves after it: a
 # reversal (G0 Z1, G1 Z0) may turn up to P short of its end, and both traces do.
@@ -77,16 +79,15 @@ def parse_program(path):
     moves, pos, mode = [], [0.0, 0.0, 0.0], None
     with open(path) as f:
         for number, text in enumerate(f, 1):
-            text = re.sub(r"\(.*?\)|;.*", "", text).strip()
-            if not text:
+            try:
+                words = words_of(text)
+            except ValueError as e:
+                sys.exit(f"{path}:{number}: {e}")
+            if not words:
                 continue
-            words = WORD.findall(text)
-            if "".join(l + v for l, v in words).replace(" ", "") != re.sub(r"\s", "", text):
-                sys.exit(f"{path}:{number}: cannot read '{text}'")
             target, ij, new_mode = list(pos), [0.0, 0.0], None
             axes = False
-            for letter, value in words:
-                letter, v = letter.upper(), float(value)
+            for letter, v, value in words:
                 if letter == "G":
                     if v in (0, 1, 2, 3):
                         new_mode = int(v)
