@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs the Debian 12 packages the project needs. Idempotent: installs only what is missing.
+# Installs the Debian 12 packages the project needs, and any packages named as arguments (what
+# a bench script needs besides). Idempotent: installs only what is missing.
 set -euo pipefail
 packages=(
   build-essential
@@ -22,6 +23,7 @@ packages=(
   libexpat1-dev
   python3-scipy
 )
+packages+=("$@")
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,25 +1,16 @@
 #!/usr/bin/env bash
 # The numerical floor (bench/floor/floor.py) on tp_default's sections where LinuxCNC leaves the
-# path (docs/benchmarks.md, "A numerical floor for sections"). Installs python3-scipy and
-# coinor-cbc if they are missing, like scripts/deps.sh. Extra arguments go to every floor.py
-# call (the last of a repeated option counts, e.g. --time-limit 600).
+# path (docs/benchmarks.md, "A numerical floor for sections"). Installs what is missing
+# (python3-scipy with the project's packages, and coinor-cbc) through scripts/deps.sh. Extra
+# arguments go to every floor.py call (the last of a repeated option counts, e.g.
+# --time-limit 600).
 #   bench/floor/run.sh
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
 # coinor-cbc is not run here: it is the second solver the docs use to check the proofs
 # (`floor.py --export-mps`, then `cbc FILE solve`).
-missing=()
-for p in python3-scipy coinor-cbc; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  sudo_cmd=""
-  [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
-  echo "floor: installing ${missing[*]}"
-  $sudo_cmd apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends "${missing[@]}"
-fi
+"$root/scripts/deps.sh" coinor-cbc
 program="$root/bench/tp_default.ngc"
 # Sections: the three row ends, the rapids between the rows and the half circles, and the last
 # four moves split at their corners (floors of sections disjoint in time add up). The row ends
