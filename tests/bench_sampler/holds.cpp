@@ -217,21 +217,9 @@ int holds_main() {
                cfg, plan(cfg, {circle(radius, 6, 100)}), 700);
     }
     {
-        // The line - quarter arc - line plan of SamplerJerk.OverrideStepsAtEveryPointOfThePlan…
-        PlannerConfig cfg = uniform(100, 1000, 1e5);
-        cfg.limits.acc_mm_s2[1] = 600;
-        cfg.limits.jerk_mm_s3[1] = 4e4;
-        PathSegment arc = feed_to(0, 80, 1);
-        arc.end_mm = {50, 10};
-        arc.kind = SegmentKind::Arc;
-        arc.centre_mm = {40, 10};
-        arc.tolerance_mm = 0.01;
-        PathSegment up = feed_to(50, 80, 2);
-        up.end_mm[1] = 40;
-        const auto recs = plan(cfg, {feed_to(40, 80, 0), arc, up});
-        double planned_s = 0;
-        for (const auto& r : recs) planned_s += r.profile.duration_s;
-        const long end_ms = long(planned_s * 1000) - 200;
+        const PlannerConfig cfg = line_arc_line_cfg(1e5);
+        const auto recs = line_arc_line(cfg);
+        const long end_ms = long(planned_s(recs) * 1000) - 200;
         sweep("line-arc-line (J 1e5), hold every 3 ms", cfg, recs, 1, end_ms, 3);
         sweep("the same, 100 % -> 30 %", cfg, recs, 1, end_ms, 3, 1, 0.3);
         sweep("the same, 40 % -> 100 % (speeding up: first column not meaningful)", cfg, recs, 1,
@@ -263,6 +251,30 @@ long reaches_ms(const std::vector<motion::PreparedSegment>& recs, double v_mm_s)
         start += r.profile.duration_s;
     }
     return long(start * 1000);
+}
+
+PlannerConfig line_arc_line_cfg(double jerk) {
+    PlannerConfig cfg = uniform(100, 1000, jerk);
+    cfg.limits.acc_mm_s2[1] = 600;
+    cfg.limits.jerk_mm_s3[1] = 0.4 * jerk;
+    return cfg;
+}
+
+std::vector<PreparedSegment> line_arc_line(const PlannerConfig& cfg) {
+    PathSegment arc = feed_to(0, 80, 1);
+    arc.end_mm = {50, 10};
+    arc.kind = SegmentKind::Arc;
+    arc.centre_mm = {40, 10};
+    arc.tolerance_mm = 0.01;
+    PathSegment up = feed_to(50, 80, 2);
+    up.end_mm[1] = 40;
+    return plan(cfg, {feed_to(40, 80, 0), arc, up});
+}
+
+double planned_s(const std::vector<PreparedSegment>& recs) {
+    double t = 0;
+    for (const PreparedSegment& r : recs) t += r.profile.duration_s;
+    return t;
 }
 
 }  // namespace sampler_holds

@@ -262,31 +262,6 @@ void sweep(const std::string& name, const PlannerConfig& cfg,
                bad ? fmt::format(" LIMITS LEFT in {} runs", bad) : "");
 }
 
-// The line - quarter arc - line plan of SamplerJerk.OverrideStepsAtEveryPointOfThePlan…, its
-// jerk limits scaled to `jerk` (Y weaker: 600 mm/s^2, 0.4 of the jerk).
-PlannerConfig line_arc_line_cfg(double jerk) {
-    PlannerConfig cfg = uniform(100, 1000, jerk);
-    cfg.limits.acc_mm_s2[1] = 600;
-    cfg.limits.jerk_mm_s3[1] = 0.4 * jerk;
-    return cfg;
-}
-std::vector<PreparedSegment> line_arc_line(const PlannerConfig& cfg) {
-    PathSegment arc = feed_to(0, 80, 1);
-    arc.end_mm = {50, 10};
-    arc.kind = SegmentKind::Arc;
-    arc.centre_mm = {40, 10};
-    arc.tolerance_mm = 0.01;
-    PathSegment up = feed_to(50, 80, 2);
-    up.end_mm[1] = 40;
-    return sampler_holds::plan(cfg, {feed_to(40, 80, 0), arc, up});
-}
-
-double planned_s(const std::vector<PreparedSegment>& recs) {
-    double t = 0;
-    for (const auto& r : recs) t += r.profile.duration_s;
-    return t;
-}
-
 }  // namespace
 
 int raises_main(const Options& opt) {
@@ -326,10 +301,10 @@ int raises_main(const Options& opt) {
                               jerk, to_ms),
                   cfg, slow, 5, to_ms, 5, 1, 1.2, nullptr, verdict);
         }
-        const PlannerConfig lal_cfg = line_arc_line_cfg(jerk);
-        const auto lal = line_arc_line(lal_cfg);
+        const PlannerConfig lal_cfg = sampler_holds::line_arc_line_cfg(jerk);
+        const auto lal = sampler_holds::line_arc_line(lal_cfg);
         // At 40 % the plan takes 2.5 times as long; raises over the first 80 % of that.
-        const long lal_to_ms = long(planned_s(lal) / 0.4 * 1000 * 0.8);
+        const long lal_to_ms = long(sampler_holds::planned_s(lal) / 0.4 * 1000 * 0.8);
         const long lal_every = opt.short_grid ? 9 : 3;
         sweep(fmt::format("J {:g}: line-arc-line, 40 % -> 100 %, every {} ms of the first {} ms",
                           jerk, lal_every, lal_to_ms),
