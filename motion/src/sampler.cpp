@@ -506,12 +506,7 @@ double Sampler::advance_rate_jerk(double target, double dt) noexcept {
         RateState end{r_, rd_};
         for (int i = 0; i < move.count; ++i) step_rate(end, move.pieces[static_cast<std::size_t>(i)]);
         RatePath backup;
-        if (!brake_path(end, lim, backup)) continue;
-        RatePath whole = move;
-        for (int i = 0; i < backup.count; ++i) whole.add(backup.pieces[static_cast<std::size_t>(i)]);
-        if (whole.count == RatePath::kMaxPieces || !rate_path_safe(whole)) continue;
-        cert_ = backup;
-        last_limits_ = lim;
+        if (!brake_path(end, lim, backup) || !certify(move, backup, lim)) continue;
         return apply_rate(move);
     }
     RatePath head;
@@ -596,16 +591,11 @@ bool Sampler::directed_moves(double goal, double dt, const RateLimits& room, dou
         if (!coast_backup(end.r, end.rd, tau_end, am_hint, backup, r_end) ||
             (down ? r_end < goal - 1e-9 : r_end > goal + 1e-9))
             return false;
-        RatePath whole = move;
-        for (int i = 0; i < backup.count; ++i)
-            whole.add(backup.pieces[static_cast<std::size_t>(i)]);
-        if (whole.count >= RatePath::kMaxPieces || !rate_path_safe(whole)) return false;
-        cert_ = backup;
         // What the next periods' reach estimates (jerk_room_limits(), rate_cap_ahead())
         // take as the r' to brake and the r'' to brake it with: the r' reached, not the cap.
-        last_limits_ = {std::max(std::fabs(end.rd), rl_.max_rate_per_s),
-                        std::max(am_hint, room.max_rate_per_s2)};
-        return true;
+        return certify(move, backup,
+                       {std::max(std::fabs(end.rd), rl_.max_rate_per_s),
+                        std::max(am_hint, room.max_rate_per_s2)});
     };
     if (am1 > rl_.max_rate_per_s2) {
         RatePath move;
@@ -682,12 +672,18 @@ bool Sampler::approach(double goal, double dt, const RateLimits& lim, double& pa
     if (!brake_path(end, lim, backup) ||
         end.r + end.rd * end.rd / (2 * lim.max_rate_per_s2) > goal + 1e-9)
         return false;
+    if (!certify(move, backup, lim)) return false;
+    passed = apply_rate(move);
+    return true;
+}
+
+bool Sampler::certify(const RatePath& move, const RatePath& backup,
+                      const RateLimits& after) noexcept {
     RatePath whole = move;
     for (int i = 0; i < backup.count; ++i) whole.add(backup.pieces[static_cast<std::size_t>(i)]);
     if (whole.count >= RatePath::kMaxPieces || !rate_path_safe(whole)) return false;
     cert_ = backup;
-    last_limits_ = lim;
-    passed = apply_rate(move);
+    last_limits_ = after;
     return true;
 }
 

@@ -210,6 +210,9 @@ class Sampler {
     bool directed_moves(double goal, double dt, const RateLimits& room, double vm_acc,
                         double& passed) noexcept;
     bool approach(double goal, double dt, const RateLimits& lim, double& passed) noexcept;
+    // `move` then `backup` passes the check: `backup` becomes the certificate and `after` the
+    // limits the next periods' reach estimates take (the move itself is the caller's to apply).
+    bool certify(const RatePath& move, const RatePath& backup, const RateLimits& after) noexcept;
     RateLimits jerk_room_limits(double target, double dt, double* vm_acc_out = nullptr) noexcept;
     bool rate_path_safe(const RatePath& path) noexcept;
     // The largest |r''| of each sign that keeps the tangential jerk j r^3 + 3 a r r' + v r''
