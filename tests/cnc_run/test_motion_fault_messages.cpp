@@ -120,6 +120,17 @@ double ms(Clock::duration d) {
     return std::chrono::duration<double, std::milli>(d).count();
 }
 
+// The fault's end record arrives on motion.messages within kLatencyBound (the wait is the test's
+// latency_us property), with this place and cause.
+void expect_end_record(MotionMachine& m, const std::string& place, const std::string& cause) {
+    const auto latency = m.await_end(kLatencyBound);
+    ASSERT_TRUE(latency) << "no end record on motion.messages within 200 ms of the fault";
+    ::testing::Test::RecordProperty("latency_us", static_cast<int>(ms(*latency) * 1000));
+    ASSERT_TRUE(m.end());
+    EXPECT_EQ(m.end()->place, place);
+    EXPECT_EQ(m.end()->cause, cause);
+}
+
 // The end record arrives before stop, within the bound; after stop and unload's reports
 // nothing more is sent (one end record in all).
 void expect_once_after_stop(MotionMachine& m) {
@@ -138,14 +149,10 @@ TEST(MotionFaultMessages, LimitSwitchTextArrivesWhileTheMachineRuns) {
     m.run("setp joint.0.pos-lim-sw-in TRUE");
     m.run("advance 0.001");  // the servo period that sees the switch
     ASSERT_TRUE(m.bit("motion.fault"));
-    const auto latency = m.await_end(kLatencyBound);
-    ASSERT_TRUE(latency) << "no end record on motion.messages within 200 ms of the fault";
-    RecordProperty("latency_us", static_cast<int>(ms(*latency) * 1000));
-    ASSERT_TRUE(m.end());
-    EXPECT_EQ(m.end()->place, "");
-    EXPECT_EQ(m.end()->cause,
-              "joint 0 hit its positive limit switch (joint.0.pos-lim-sw-in); motion stopped, "
-              "program abandoned");
+    expect_end_record(
+        m, "",
+        "joint 0 hit its positive limit switch (joint.0.pos-lim-sw-in); motion stopped, "
+        "program abandoned");
     expect_once_after_stop(m);
 }
 
@@ -157,14 +164,10 @@ TEST(MotionFaultMessages, FollowingErrorTextNamesTheLineRunning) {
     MotionMachine m("G90 G21\nG1 X10 F6000\nM30\n", {"setp joint.0.max-ferror 0.5"});
     m.run("advance 0.032");
     ASSERT_TRUE(m.bit("motion.fault"));
-    const auto latency = m.await_end(kLatencyBound);
-    ASSERT_TRUE(latency) << "no end record on motion.messages within 200 ms of the fault";
-    RecordProperty("latency_us", static_cast<int>(ms(*latency) * 1000));
-    ASSERT_TRUE(m.end());
-    EXPECT_EQ(m.end()->place, m.program() + ":2");
-    EXPECT_EQ(m.end()->cause,
-              "joint 0 following error 0.5069 mm, over its limit joint.0.max-ferror = 0.5 mm; "
-              "motion stopped, program abandoned");
+    expect_end_record(
+        m, m.program() + ":2",
+        "joint 0 following error 0.5069 mm, over its limit joint.0.max-ferror = 0.5 mm; "
+        "motion stopped, program abandoned");
     expect_once_after_stop(m);
 }
 
@@ -182,13 +185,8 @@ TEST(MotionFaultMessages, EStopAfterTheProgramEndedArrivesWhileLoaded) {
     m.run("setp iocontrol.0.emc-enable-in FALSE");
     m.run("advance 0.001");
     ASSERT_TRUE(m.bit("motion.fault"));
-    const auto latency = m.await_end(kLatencyBound);
-    ASSERT_TRUE(latency) << "no end record on motion.messages within 200 ms of the e-stop";
-    RecordProperty("latency_us", static_cast<int>(ms(*latency) * 1000));
-    ASSERT_TRUE(m.end());
-    EXPECT_EQ(m.end()->place, "");
-    EXPECT_EQ(m.end()->cause,
-              "e-stop: iocontrol.0.emc-enable-in went FALSE; motion stopped, program abandoned");
+    expect_end_record(
+        m, "", "e-stop: iocontrol.0.emc-enable-in went FALSE; motion stopped, program abandoned");
     expect_once_after_stop(m);
 }
 
@@ -198,11 +196,8 @@ TEST(MotionFaultMessages, WaitTimeoutArrivesBeforeStopAndOnce) {
     MotionMachine m("G90 G21\nG1 X10 F6000\nG906 PLC[0] LEVEL1 P500\nG1 X20\nM30\n");
     m.run("advance 0.72");
     ASSERT_TRUE(m.bit("motion.fault"));
-    const auto latency = m.await_end(kLatencyBound);
-    ASSERT_TRUE(latency) << "no end record on motion.messages within 200 ms of the fault";
-    ASSERT_TRUE(m.end());
-    EXPECT_EQ(m.end()->place, m.program() + ":3");
-    EXPECT_EQ(m.end()->cause, "G906: motion.digital-in-00 did not become TRUE within 0.5 s");
+    expect_end_record(m, m.program() + ":3",
+                      "G906: motion.digital-in-00 did not become TRUE within 0.5 s");
     expect_once_after_stop(m);
 }
 
