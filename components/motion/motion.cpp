@@ -23,11 +23,13 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
 #include "../machine_program_ini.hpp"
 #include "hal/component.hpp"
+#include "hal/worker.hpp"
 #include "interp/canon_wire.hpp"
 #include "kins_link.hpp"
 #include "motion/kinematics.hpp"
@@ -43,7 +45,8 @@ constexpr double kMaxOverride = 1.2;
 constexpr long kMaxDio = 64;  // NcStudio's M901 H0..H63
 
 // Why motion faulted, kept by the servo function for the text the non-realtime side makes of
-// it (on motion.messages as soon as the feeder thread polls, on stderr at stop or unload).
+// it (on motion.messages as soon as the stream's producer polls; on stderr at stop or unload
+// if no reader took it from the stream).
 enum class FaultCause : std::uint8_t {
     None,
     EStop,
@@ -150,7 +153,10 @@ class Motion : public hal::Instance {
 
     void start() override {
         if (sampler_) {  // a restart after stop: planning continues where it paused
-            if (feeder_) feeder_->start_and_wait_ready();
+            if (feeder_)
+                feeder_->start_and_wait_ready();
+            else
+                start_fault_poller();
             return;
         }
         motion::PlannerConfig plan = planner_config();
@@ -162,7 +168,10 @@ class Motion : public hal::Instance {
         }
         sampler_ = std::make_unique<motion::Sampler>(motion::sampler_config(plan), ring_,
                                                      motion::AxisArray{});
-        if (program_path_.empty() && !canon_) return;
+        if (program_path_.empty() && !canon_) {
+            start_fault_poller();
+            return;
+        }
         motioncomp::FeederConfig cfg;
         cfg.program_path = program_path_;
         if (canon_) cfg.canon_source = [this](interp::wire::Record& r) { return pop_canon(r); };
@@ -175,11 +184,10 @@ class Motion : public hal::Instance {
         cfg.on_text = [this](const interp::Canon& c) { publish_text(c); };
         cfg.on_error = [this](const std::optional<interp::SourceLoc>& where,
                               std::string_view cause) {
-            publish_fault();  // a servo fault noted first stopped the program first
-            publish_error(where, cause);
+            publish_faults();  // a servo fault noted first stopped the program first
+            publish_planner_error(where, cause);
         };
-        cfg.on_poll = [this] { publish_fault(); };
-        error_published_ = false;  // a new run of the program (after a start that failed)
+        cfg.on_poll = [this] { publish_faults(); };
         feeder_ = std::make_unique<motioncomp::ProgramFeeder>(std::move(cfg), ring_);
         const bool failed_early = feeder_->start_and_wait_ready();
         // An error found before the first servo period is a configuration error: say so now,
@@ -190,6 +198,7 @@ class Motion : public hal::Instance {
             const std::string message = feeder_->error();
             feeder_->stop();  // joined while feeder_ still points at it (on_poll reads it)
             feeder_.reset();
+            errors_.clear();  // the start's error says it
             sampler_.reset();
             while (ring_.size() > 0) ring_.pop();
             throw hal::Error(message);
@@ -198,12 +207,14 @@ class Motion : public hal::Instance {
 
     void stop() override {
         if (feeder_) feeder_->stop();
+        fault_poller_.pause_and_join();
         report_late_error();
         report_joint_excess();
     }
 
     ~Motion() override {
         if (feeder_) feeder_->stop();
+        fault_poller_.pause_and_join();
         report_late_error();
         report_joint_excess();
     }
@@ -292,16 +303,17 @@ class Motion : public hal::Instance {
     }
 
     // motion.messages, in the canonical stream's wire form, for `cnc run` or another reader:
-    // M801 messages and warnings as commands, and the program's error as an end record with
-    // its place (file, line, column when known) apart from its cause. hal::Stream is SPSC, so
-    // one producer at a time, handed over only where a thread join orders the two:
-    //  - the feeder thread from start() until stop() joins it: texts as they are planned, a
-    //    planning error when it is found, and a fault of the servo function within a
-    //    millisecond of the period that noted it (the thread stays after the program is over
-    //    to poll for that: ProgramFeeder::linger);
-    //  - the configuration world after the join (stop, unload, a start that failed): a fault
-    //    noted while no feeder thread ran (no program, or after stop), and nothing twice.
-    // The servo function never writes it: it only fills report_ and raises fault_noted_.
+    // M801 messages and warnings as commands, and errors as end records with their place
+    // (file, line, column when known) apart from their cause. hal::Stream is SPSC, so one
+    // producer at a time, handed over only where a thread join orders the two:
+    //  - from start() until stop() joins it, the instance's one non-realtime thread: the feeder
+    //    thread (texts as they are planned, a planning error when it is found, and each fault
+    //    of the servo function within a millisecond of the period that noted it: the thread
+    //    stays after the program is over to poll for them, ProgramFeeder::linger), or, in an
+    //    instance without program= and canon=, the fault poller (faults only);
+    //  - the configuration world after the join (stop, unload, a start that failed): faults
+    //    noted while no thread ran (after stop), and nothing twice.
+    // The servo function never writes the stream: it only pushes reports into faults_.
     void publish_text(const interp::Canon& c) {
         const std::size_t files = text_encoder_.files_announced();
         text_records_.clear();
@@ -309,48 +321,85 @@ class Motion : public hal::Instance {
         publish_records(files);
     }
 
-    // The servo function's fault, once, by the stream's current producer (see above). The
-    // acquire pairs with note_fault()'s release: report_ is complete and no longer written.
-    void publish_fault() {
-        if (fault_published_ || !fault_noted_.load(std::memory_order_acquire)) return;
-        const std::string cause = fault_cause(report_);
-        if (names_line(report_.cause)) {
-            const std::string file = feeder_ ? feeder_->program_file() : program_path_;
-            publish_error(interp::SourceLoc{file, report_.line, 0}, cause);
-        } else {
-            publish_error(std::nullopt, cause);
-        }
-        fault_published_ = true;  // after: a throw above leaves it for the next poll
+    // An instance without a feeder thread still needs a producer polling faults_ while it runs
+    // (a machine driven by jogs or a HAL stream of its own faults as well); started by start(),
+    // joined by stop(). Polling, as the servo function may not wake a thread.
+    void start_fault_poller() {
+        fault_poller_.start_and_wait_ready([this] {
+            fault_poller_.mark_ready(false);
+            while (!fault_poller_.pause_requested()) {
+                try {
+                    publish_faults();
+                } catch (const std::exception&) {
+                    // Out of memory formatting a text: tried again at the next poll.
+                }
+                std::this_thread::sleep_for(motioncomp::ProgramFeeder::kLingerPoll);
+            }
+        });
     }
 
-    // The first error of a run only: the one that stopped the program.
-    void publish_error(const std::optional<interp::SourceLoc>& where, std::string_view cause) {
-        if (error_published_) return;
-        error_published_ = true;
+    // Each fault the servo function noted, in order, by the stream's current producer (see
+    // above), each as an end record of its own: the first is the one that stopped the program,
+    // a later one is another fault (a limit switch in a drive fault's stop ramp, a fault after
+    // a reset). A fault at a program line has no place in an instance without a program (a
+    // following error while jogging). The report leaves faults_ only once its records are
+    // built and pushed (or dropped), so a throw retries it at the next poll.
+    void publish_faults() {
+        while (faults_.size() > 0) {
+            const FaultReport r = faults_.peek(0);
+            const std::string cause = fault_cause(r);
+            const std::string file = feeder_ ? feeder_->program_file() : program_path_;
+            if (names_line(r.cause) && !file.empty()) {
+                publish_error(interp::SourceLoc{file, r.line, 0}, cause,
+                              fmt::format("{}:{}: {}", file, r.line, cause));
+            } else {
+                publish_error(std::nullopt, cause, cause);
+            }
+            faults_.pop();
+        }
+    }
+
+    // The planner thread's error (or the interp component's, through canon=), on that thread.
+    // Its stderr text is the feeder's, "file:line:col: reason".
+    void publish_planner_error(const std::optional<interp::SourceLoc>& where,
+                               std::string_view cause) {
+        publish_error(where, cause.empty() ? "the program failed" : cause, feeder_->error());
+    }
+
+    // One error as an end record, remembered with its stderr text `text` and the number of
+    // records pushed once it was in: a reader that has popped that many has taken it.
+    void publish_error(const std::optional<interp::SourceLoc>& where, std::string_view cause,
+                       std::string text) {
         const std::size_t files = text_encoder_.files_announced();
         text_records_.clear();
         if (where)
             text_encoder_.end(*where, cause, text_records_);
         else
-            text_encoder_.end(cause.empty() ? "the program failed" : cause, text_records_);
-        publish_records(files);
+            text_encoder_.end(cause, text_records_);
+        SentError e{std::move(text), 0};
+        errors_.reserve(errors_.size() + 1);  // a throw here leaves nothing pushed
+        if (publish_records(files)) e.taken_at = records_pushed_;
+        errors_.push_back(std::move(e));
     }
 
     // A text that does not fit (nobody reads the stream) is dropped whole, so a reader never
     // sees half of one, and counted on motion.message-dropped (motion.message-count still
     // counts the messages reached). A file announced only in the dropped records is announced
     // again by the next text that names it.
-    void publish_records(std::size_t files_before) {
+    // Returns whether the text went out.
+    bool publish_records(std::size_t files_before) {
         if (messages_.depth() - messages_.used() < text_records_.size()) {
             text_encoder_.forget_files_after(files_before);
             dropped_texts_.fetch_add(1, std::memory_order_relaxed);
-            return;
+            return false;
         }
         hal::Value v[interp::wire::kWireFields];
         for (const interp::wire::Record& r : text_records_) {
             for (std::size_t i = 0; i < r.size(); ++i) v[i].u64 = r[i];
             messages_.push(v);
+            ++records_pushed_;
         }
+        return true;
     }
 
     // The feeder thread's read of the canonical stream (canon=).
@@ -440,12 +489,13 @@ class Motion : public hal::Instance {
         }
     }
 
-    // The first fault is the one reported. report_ is written once, before the release that
-    // lets the stream's producer read it (publish_fault), and never again.
+    // Every fault is reported: the callers note one when a latch sets (a drive or
+    // following-error trip, a limit, the e-stop, a program fault, a lost kinematics), so at
+    // most one of each kind until motion.enable rises again. faults_ is preallocated; one that
+    // finds it full (more than kFaultReports faults before the producer's next poll) is only
+    // counted, and said at stop.
     void note_fault(const FaultReport& r) noexcept {
-        if (fault_noted_.load(std::memory_order_relaxed)) return;
-        report_ = r;
-        fault_noted_.store(true, std::memory_order_release);
+        if (!faults_.try_push(r)) faults_lost_.fetch_add(1, std::memory_order_relaxed);
     }
 
     // ---- machine commands (action records) ----
@@ -819,26 +869,22 @@ class Motion : public hal::Instance {
     }
 
     // An error met while the program was already running has only the fault pin in realtime;
-    // the text is printed here, in the configuration world, once (on stderr at stop, so a HAL
-    // file's output keeps its order). Called after the feeder thread is joined, so this world
-    // is motion.messages' producer now: a servo fault the feeder thread has not published yet
-    // (none ran, or it came after the join) goes out from here; one it published is not sent
-    // again. The feeder thread sent its own error when it met it.
+    // its text goes to motion.messages (above) and, for a reader-less instance (halrun), to
+    // stderr here, in the configuration world, at stop, so a HAL file's output keeps its order.
+    // Called after the producer thread is joined, so this world is motion.messages' producer
+    // now: faults not published yet (they came after the join) go out from here. Then each
+    // error a reader has not taken from the stream is printed once; one a reader took (`cnc
+    // run` does, and prints it itself) is not, so it is told once.
     void report_late_error() {
-        publish_fault();
-        if (!fault_reported_ && fault_noted_.load(std::memory_order_acquire)) {
-            fault_reported_ = true;
-            const std::string cause = fault_cause(report_);
-            if (names_line(report_.cause)) {
-                const std::string file = feeder_ ? feeder_->program_file() : program_path_;
-                fmt::print(stderr, "{}: {}:{}: {}\n", name(), file, report_.line, cause);
-            } else {
-                fmt::print(stderr, "{}: {}\n", name(), cause);
-            }
-        }
-        if (error_reported_ || !feeder_ || !feeder_->failed()) return;
-        error_reported_ = true;
-        fmt::print(stderr, "{}: {}\n", name(), feeder_->error());
+        publish_faults();
+        const std::uint64_t taken = records_pushed_ - messages_.used();
+        for (const SentError& e : errors_)
+            if (e.taken_at == 0 || taken < e.taken_at)
+                fmt::print(stderr, "{}: {}\n", name(), e.text);
+        errors_.clear();
+        const std::uint32_t lost = faults_lost_.exchange(0, std::memory_order_relaxed);
+        if (lost > 0)
+            fmt::print(stderr, "{}: {} more fault(s) came too fast to be reported\n", name(), lost);
     }
 
     // Faults of a program action or move, at its line (FaultReport::line): a following error
@@ -1228,9 +1274,19 @@ class Motion : public hal::Instance {
     // motion.messages' producer only (see publish_text).
     interp::wire::Encoder text_encoder_;
     std::vector<interp::wire::Record> text_records_;
-    bool error_published_ = false;
-    bool fault_published_ = false;  // report_ is on the stream (or was refused as not first)
-    std::atomic<bool> fault_noted_{false};         // the servo function filled report_ (release)
+    std::uint64_t records_pushed_ = 0;
+    // The errors sent (or dropped) since the last stop, with their stderr texts, for
+    // report_late_error().
+    struct SentError {
+        std::string text;
+        std::uint64_t taken_at = 0;  // records_pushed_ with it in; 0: not on the stream
+    };
+    std::vector<SentError> errors_;
+    // Faults the servo function noted, to the stream's producer (it pops). Preallocated.
+    static constexpr std::size_t kFaultReports = 8;
+    motion::SpscRing<FaultReport> faults_{kFaultReports};
+    std::atomic<std::uint32_t> faults_lost_{0};  // notes faults_ had no room for
+    hal::Worker fault_poller_;  // without a feeder: the producer from start() to stop()
     std::atomic<std::uint32_t> dropped_texts_{0};  // the producer adds, the servo function reads
     motion::AxisArray home_shift_mm_{};  // machine coordinate minus planner frame (M902)
     bool limits_masked_ = false;         // M802 P131072 until P131073
@@ -1264,12 +1320,9 @@ class Motion : public hal::Instance {
     EStop estop_ = EStop::Resetting;  // ready as soon as emc-enable-in reads TRUE
     std::vector<char> pos_lim_seen_, neg_lim_seen_;  // last values, for rising edges
     std::vector<double> lim_prev_cmd_mm_;            // joint commands of the period before last
-    FaultReport report_;          // the servo function's first fault; read after fault_noted_
     std::int32_t last_line_ = 0;  // motion.program-line as last written
     std::uint32_t starved_count_ = 0;
     bool lockstep_ = false;  // wait for the planner each period (simulated clock only)
-    bool error_reported_ = false;
-    bool fault_reported_ = false;
 
     // Machine-command state.
     int spindle_dir_ = 0;  // 1 forward, -1 reverse, 0 stopped

@@ -3,6 +3,8 @@
 // when it is stopped: the end record with the fault's place and cause is there within 200 ms
 // of wall time after the servo period that saw the fault, with the simulated clock not moved
 // on in between (so within 0 ms of machine time), and it is sent once, also after `stop`.
+// Also from an instance without program= (nothing to plan, so no planner thread), and for
+// every fault, not only a load's first: each later one gets an end record of its own.
 // The motion component runs in a HAL instance of this process (hal::Runtime, simulated clock),
 // so the test reads the stream while nothing is stopped. Figures by hand from the programs.
 #include <fmt/format.h>
@@ -39,8 +41,8 @@ struct EndRecord {
 
 class MotionMachine {
   public:
-    // motion with `program` (written into a scratch folder), a 1 ms servo thread, enabled,
-    // started. `setup` lines run before `start`.
+    // motion with `program` (written into a scratch folder; "": no program=), a 1 ms servo
+    // thread, enabled, started. `setup` lines run before `start`.
     MotionMachine(const std::string& program, const std::vector<std::string>& setup = {}) {
         static int counter = 0;
         rt_ = std::make_unique<hal::Runtime>(
@@ -48,7 +50,8 @@ class MotionMachine {
                                   hal::kDefaultSegmentBytes, true});
         program_ = (scratch_.path() / "prog.ngc").string();
         std::ofstream(program_) << program;
-        run(fmt::format("loadrt motion program={}", program_));
+        run(program.empty() ? std::string("loadrt motion")
+                            : fmt::format("loadrt motion program={}", program_));
         run("loadrt threads name1=servo period1=1000000");
         run("addf motion-controller servo");
         run("setp motion.enable TRUE");
@@ -77,34 +80,38 @@ class MotionMachine {
     const std::string& program() const { return program_; }
 
     // Takes what is on motion.messages now; true once an end record has been decoded.
-    bool drain() {
+    bool drain() { return take() > 0; }
+    // Takes what is on motion.messages now; the number of end records decoded so far.
+    std::size_t take() {
         hal::Value v[interp::wire::kWireFields];
         while (ring_->pop(v)) {
             interp::wire::Record r;
             for (std::size_t i = 0; i < r.size(); ++i) r[i] = v[i].u64;
             if (decoder_.feed(r) != interp::wire::Decoder::Item::End) continue;
-            ++ends_;
-            if (!decoder_.failed()) continue;
             const auto& at = decoder_.error_loc();
-            end_ = EndRecord{!at           ? ""
-                             : at->col > 0 ? fmt::format("{}:{}:{}", at->file, at->line, at->col)
-                                           : fmt::format("{}:{}", at->file, at->line),
-                             decoder_.error_cause()};
+            ends_.push_back(EndRecord{!at ? ""
+                                      : at->col > 0
+                                          ? fmt::format("{}:{}:{}", at->file, at->line, at->col)
+                                          : fmt::format("{}:{}", at->file, at->line),
+                                      decoder_.failed() ? decoder_.error_cause() : "(not failed)"});
         }
-        return ends_ > 0;
+        return ends_.size();
     }
-    // Waits (wall time, the simulated clock standing still) for the end record; how long it
-    // took, or nullopt if none came within `bound`.
-    std::optional<Clock::duration> await_end(Clock::duration bound) {
+    // Waits (wall time, the simulated clock standing still) for the n-th end record; how long
+    // it took, or nullopt if it did not come within `bound`.
+    std::optional<Clock::duration> await_end(Clock::duration bound, std::size_t n = 1) {
         const auto t0 = Clock::now();
-        while (!drain()) {
+        while (take() < n) {
             if (Clock::now() - t0 > bound) return std::nullopt;
             std::this_thread::sleep_for(std::chrono::microseconds(100));
         }
         return Clock::now() - t0;
     }
-    const std::optional<EndRecord>& end() const { return end_; }
-    int ends() const { return ends_; }
+    // The last end record, if any.
+    std::optional<EndRecord> end() const {
+        return ends_.empty() ? std::nullopt : std::optional<EndRecord>(ends_.back());
+    }
+    std::size_t ends() const { return ends_.size(); }
 
   private:
     cnc_test::ScratchDir scratch_;
@@ -112,32 +119,33 @@ class MotionMachine {
     std::unique_ptr<hal::Runtime> rt_;
     hal::Ring* ring_ = nullptr;
     interp::wire::Decoder decoder_;
-    std::optional<EndRecord> end_;
-    int ends_ = 0;
+    std::vector<EndRecord> ends_;
 };
 
 double ms(Clock::duration d) {
     return std::chrono::duration<double, std::milli>(d).count();
 }
 
-// The fault's end record arrives on motion.messages within kLatencyBound (the wait is the test's
-// latency_us property), with this place and cause.
-void expect_end_record(MotionMachine& m, const std::string& place, const std::string& cause) {
-    const auto latency = m.await_end(kLatencyBound);
-    ASSERT_TRUE(latency) << "no end record on motion.messages within 200 ms of the fault";
+// The fault's end record (the n-th) arrives on motion.messages within kLatencyBound (the wait is
+// the test's latency_us property), with this place and cause.
+void expect_end_record(MotionMachine& m, const std::string& place, const std::string& cause,
+                       std::size_t n = 1) {
+    const auto latency = m.await_end(kLatencyBound, n);
+    ASSERT_TRUE(latency) << "no end record " << n
+                         << " on motion.messages within 200 ms of the fault";
     ::testing::Test::RecordProperty("latency_us", static_cast<int>(ms(*latency) * 1000));
     ASSERT_TRUE(m.end());
     EXPECT_EQ(m.end()->place, place);
     EXPECT_EQ(m.end()->cause, cause);
 }
 
-// The end record arrives before stop, within the bound; after stop and unload's reports
-// nothing more is sent (one end record in all).
-void expect_once_after_stop(MotionMachine& m) {
+// The end records arrived before stop, within the bound; after stop and unload's reports
+// nothing more is sent (`n` end records in all).
+void expect_once_after_stop(MotionMachine& m, std::size_t n = 1) {
     m.run("advance 0.5");  // the fault stop runs out
     m.run("stop");
-    m.drain();
-    EXPECT_EQ(m.ends(), 1);
+    m.take();
+    EXPECT_EQ(m.ends(), n);
 }
 
 // X's positive limit switch closes in the middle of the G1 (100 mm/s from X0 to X100, line 2)
@@ -199,6 +207,64 @@ TEST(MotionFaultMessages, WaitTimeoutArrivesBeforeStopAndOnce) {
     expect_end_record(m, m.program() + ":3",
                       "G906: motion.digital-in-00 did not become TRUE within 0.5 s");
     expect_once_after_stop(m);
+}
+
+// No program= and no canon=: the instance plans nothing and has no planner thread, but a
+// thread of its own polls for faults from start to stop (the old motion sent this only at
+// stop). A limit switch closing while the machine is enabled at rest trips.
+TEST(MotionFaultMessages, InstanceWithoutProgramSendsItsFaultWhileRunning) {
+    MotionMachine m("");
+    m.run("advance 0.01");
+    EXPECT_FALSE(m.drain()) << "an end record before any fault";
+    m.run("setp joint.2.neg-lim-sw-in TRUE");
+    m.run("advance 0.001");
+    ASSERT_TRUE(m.bit("motion.fault"));
+    expect_end_record(
+        m, "",
+        "joint 2 hit its negative limit switch (joint.2.neg-lim-sw-in); motion stopped, "
+        "program abandoned");
+    expect_once_after_stop(m);
+}
+
+// Each fault is sent, not only the first: a drive fault on X in the G1 (line 2, 0.1 s in), a
+// limit switch of joint 1 during its stop ramp (from about 99 mm/s at 1000 mm/s^2, about
+// 0.1 s: still running 2 ms later), and, after a reset (motion.enable falls and rises, the
+// inputs clear), the e-stop. Three end records, each within the bound, in order; none again
+// at stop.
+TEST(MotionFaultMessages, EveryFaultIsSentNotOnlyTheFirst) {
+    MotionMachine m("G90 G21\nG1 X100 F6000\nM30\n");
+    m.run("advance 0.1");
+    m.run("setp joint.0.amp-fault-in TRUE");
+    m.run("advance 0.001");
+    ASSERT_TRUE(m.bit("motion.fault"));
+    expect_end_record(m, "",
+                      "joint 0 drive fault (joint.0.amp-fault-in); motion stopped, program "
+                      "abandoned");
+    m.run("advance 0.002");
+    ASSERT_GT(std::stod(m.run("getp motion.current-vel")), 1.0) << "the stop ramp is over";
+    m.run("setp joint.1.neg-lim-sw-in TRUE");
+    m.run("advance 0.001");
+    expect_end_record(
+        m, "",
+        "joint 1 hit its negative limit switch (joint.1.neg-lim-sw-in); motion stopped, "
+        "program abandoned",
+        2);
+    m.run("advance 0.2");
+    m.run("setp joint.0.amp-fault-in FALSE");
+    m.run("setp joint.1.neg-lim-sw-in FALSE");
+    m.run("setp motion.enable FALSE");
+    m.run("advance 0.001");
+    m.run("setp motion.enable TRUE");
+    m.run("advance 0.01");
+    ASSERT_FALSE(m.bit("motion.fault")) << "not reset";
+    EXPECT_EQ(m.take(), 2u) << "an end record without a fault";
+    m.run("setp iocontrol.0.emc-enable-in FALSE");
+    m.run("advance 0.001");
+    ASSERT_TRUE(m.bit("motion.fault"));
+    expect_end_record(
+        m, "", "e-stop: iocontrol.0.emc-enable-in went FALSE; motion stopped, program abandoned",
+        3);
+    expect_once_after_stop(m, 3);
 }
 
 }  // namespace

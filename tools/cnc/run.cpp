@@ -414,9 +414,9 @@ class Progress {
     double next_plain_s_ = 1.0;
 };
 
-// The program's error as motion tells it on motion.messages: the place ("file:line", or
-// "file:line:col" when the column is known; empty for a fault that names no line, such as a
-// limit switch) and the cause.
+// An error as motion tells it on motion.messages: the place ("file:line", or "file:line:col"
+// when the column is known; empty for a fault that names no line, such as a limit switch) and
+// the cause.
 struct ProgramError {
     std::string place;
     std::string cause;
@@ -426,7 +426,8 @@ struct ProgramError {
 // stream's wire form): a warning is printed when it arrives, the n-th message when
 // motion.message-count reaches n (the machine has got there), each on a line of its own; on a
 // terminal the progress bar is cleared first and redrawn by its next update. The stream's end
-// record, if motion sends one, is the program's error, kept for the summary.
+// records are motion's errors: the first is the program's error, kept for the summary; motion
+// sends one more for each later fault (a limit switch in a drive fault's stop ramp).
 class OperatorTexts {
   public:
     OperatorTexts(hal::Runtime& rt, bool tty)
@@ -441,7 +442,9 @@ class OperatorTexts {
     }
 
     // The first error motion sent, if any (poll() first).
-    const std::optional<ProgramError>& error() const { return error_; }
+    const ProgramError* error() const { return errors_.empty() ? nullptr : &errors_.front(); }
+    // Every error motion sent so far, in order.
+    const std::vector<ProgramError>& errors() const { return errors_; }
     // False when the config's motion has no motion.messages: no error will come from it.
     bool connected() const { return ring_ != nullptr; }
 
@@ -470,11 +473,11 @@ class OperatorTexts {
         interp::wire::Record r;
         for (std::size_t i = 0; i < r.size(); ++i) r[i] = record_[i].u64;
         const interp::wire::Decoder::Item item = decoder_.feed(r);
-        if (item == interp::wire::Decoder::Item::End && decoder_.failed() && !error_) {
-            error_ = ProgramError{"", decoder_.error_cause()};
+        if (item == interp::wire::Decoder::Item::End && decoder_.failed()) {
+            ProgramError& e = errors_.emplace_back(ProgramError{"", decoder_.error_cause()});
             if (const auto& at = decoder_.error_loc())
-                error_->place = at->col > 0 ? fmt::format("{}:{}:{}", at->file, at->line, at->col)
-                                            : fmt::format("{}:{}", at->file, at->line);
+                e.place = at->col > 0 ? fmt::format("{}:{}:{}", at->file, at->line, at->col)
+                                      : fmt::format("{}:{}", at->file, at->line);
         }
         if (item != interp::wire::Decoder::Item::Command) return;
         const interp::Canon& c = decoder_.command();
@@ -495,7 +498,7 @@ class OperatorTexts {
     interp::wire::Decoder decoder_;
     std::deque<std::string> messages_;  // decoded, not yet reached
     double shown_ = 0;
-    std::optional<ProgramError> error_;
+    std::vector<ProgramError> errors_;
 };
 
 // The trace: a header row, then one row per sample: t, line, axis commands, joint feedback,
@@ -606,6 +609,7 @@ struct LoopResult {
     std::string fault_text;
     int fault_line = 0;          // the program line when the fault appeared
     bool fault_printed = false;  // its error line is on stderr already (announce_fault)
+    std::size_t errors_shown = 0;  // motion's errors on stderr (or told by the fault's line)
     Sample last;
     long samples = 0;
 };
@@ -632,7 +636,7 @@ bool operator_pressed_enter() {
 // names the refused line, not the one running) or, for one without a place (a limit switch),
 // the line running.
 std::string fault_error(const RunOptions& o, const LoopResult& r,
-                        const std::optional<ProgramError>& motion_error) {
+                        const ProgramError* motion_error) {
     const std::string running = fmt::format("{}:{}", o.program, r.fault_line);
     if (!r.fault_text.empty()) return fmt::format("{}: {}", running, r.fault_text);
     if (motion_error)
@@ -643,8 +647,9 @@ std::string fault_error(const RunOptions& o, const LoopResult& r,
 
 // A fault's error line on stderr once its cause is known, while the machine is still coming to
 // rest: a drive fault or following error at once (from the pins), any other fault when motion's
-// end record arrives on motion.messages (motion publishes it within about a millisecond). The
-// same line ends the run; this one tells the operator why the machine is stopping.
+// end record arrives on motion.messages (motion publishes it within about a millisecond). It is
+// the fault's only line on stderr: motion prints on stderr only what no reader took from
+// motion.messages, and the run's last line repeats it only if it was not printed here.
 void announce_fault(const RunOptions& o, LoopResult& r, OperatorTexts& texts) {
     if (r.outcome != Outcome::Fault || r.fault_printed) return;
     if (r.fault_text.empty() && !texts.error()) return;
@@ -654,9 +659,34 @@ void announce_fault(const RunOptions& o, LoopResult& r, OperatorTexts& texts) {
     std::fflush(stderr);
 }
 
-// After a fault, before `stop`: waits (wall time, at most kFaultTextWaitS) for motion's cause,
-// so the error line comes out before motion's own message at stop on every run, also under
-// --sim-clock, where the machine may be at rest before motion has published it.
+// motion's errors other than the run's own, once each, as they arrive (only before `stop`:
+// what motion sends at stop it has printed itself). The first is the run's fault when the run
+// ended on motion.fault (its line is announce_fault's); otherwise it is printed once the
+// outcome is `settled`, before the outcome's own line. A later one is another fault (a limit
+// switch in a drive fault's stop ramp, the e-stop): `PROGRAM:LINE: cause` with the line
+// running now when motion names no place.
+void show_motion_errors(const RunOptions& o, LoopResult& r, OperatorTexts& texts, bool settled) {
+    const std::vector<ProgramError>& errors = texts.errors();
+    if (r.errors_shown == 0 && !errors.empty()) {
+        if (r.outcome == Outcome::Fault)
+            r.errors_shown = 1;
+        else if (!settled)
+            return;  // may still become the run's fault
+    }
+    for (; r.errors_shown < errors.size(); ++r.errors_shown) {
+        const ProgramError& e = errors[r.errors_shown];
+        texts.clear_bar();
+        fmt::print(stderr, "{}: {}\n",
+                   e.place.empty() ? fmt::format("{}:{}", o.program, r.last.line) : e.place,
+                   e.cause);
+        std::fflush(stderr);
+    }
+}
+
+// After a fault, before `stop`: waits (wall time, at most kFaultTextWaitS) for motion's end
+// record, so its cause is in the error line (a fault the pins do not explain) and the record
+// has been taken from motion.messages when `stop` comes (motion then does not print it again).
+// Under --sim-clock the machine may be at rest before motion has published it.
 void await_fault_text(const RunOptions& o, LoopResult& r, OperatorTexts& texts) {
     if (!texts.connected()) return;
     const auto deadline = std::chrono::steady_clock::now() +
@@ -665,7 +695,7 @@ void await_fault_text(const RunOptions& o, LoopResult& r, OperatorTexts& texts) 
     for (;;) {
         texts.poll();
         announce_fault(o, r, texts);
-        if (r.outcome != Outcome::Fault || r.fault_printed) return;
+        if (r.outcome != Outcome::Fault || (r.fault_printed && texts.error())) return;
         if (std::chrono::steady_clock::now() >= deadline) return;
         std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
@@ -690,6 +720,7 @@ LoopResult watch(Session& session, const MachinePins& pins, const RunOptions& o,
         progress.update(s.t_s, s.line);
         texts.poll();
         announce_fault(o, r, texts);
+        show_motion_errors(o, r, texts, false);
         if (abort_at_s) {
             if (s.in_position || s.t_s > *abort_at_s + kAbortGraceS) return r;
             continue;
@@ -940,7 +971,7 @@ std::function<void(Sample&)> make_source(Session& session, const MachinePins& pi
 
 // The error line for an outcome other than Finished: `PROGRAM:LINE: what`.
 std::string outcome_error(const RunOptions& o, const LoopResult& r,
-                          const std::optional<ProgramError>& motion_error) {
+                          const ProgramError* motion_error) {
     const std::string where = fmt::format("{}:{}", o.program, r.last.line);
     switch (r.outcome) {
         case Outcome::Finished:
@@ -1022,8 +1053,11 @@ int run_session(const RunOptions& o, const Config& c, Session& session, const St
     LoopResult r = watch(session, pins, o, make_source(session, pins, o, c.period_s, stream.get()),
                          stats, progress, texts, trace.get(), preview.get(), stop);
     await_fault_text(o, r, texts);
+    show_motion_errors(o, r, texts, true);
     progress.finish(r.last.t_s, r.outcome == Outcome::Finished);
-    session.exec({"stop"});  // motion prints a late error here (and sends a servo fault's)
+    // motion prints on stderr here the errors nobody took from motion.messages, and sends the
+    // faults its threads had not sent yet.
+    session.exec({"stop"});
     texts.poll();
     if (stream && stream->lost_cycles() > 0)
         fmt::print(stderr, "warning: {} servo cycles were not sampled (this process fell behind)\n",
@@ -1040,7 +1074,7 @@ int run_session(const RunOptions& o, const Config& c, Session& session, const St
         fmt::print("preview: {}\n", o.preview_path);
     }
     if (error.empty()) return 0;
-    fmt::print(stderr, "{}\n", error);
+    if (!r.fault_printed) fmt::print(stderr, "{}\n", error);
     return r.outcome == Outcome::Interrupted ? 130 : 1;
 }
 
