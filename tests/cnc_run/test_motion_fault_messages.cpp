@@ -148,21 +148,38 @@ void expect_once_after_stop(MotionMachine& m, std::size_t n = 1) {
     EXPECT_EQ(m.ends(), n);
 }
 
-// X's positive limit switch closes in the middle of the G1 (100 mm/s from X0 to X100, line 2)
-// 0.1 s in: a limit fault, which names no line (the switch is the machine's, whatever runs).
-TEST(MotionFaultMessages, LimitSwitchTextArrivesWhileTheMachineRuns) {
-    MotionMachine m("G90 G21\nG1 X100 F6000\nM30\n");
+// Runs `setp` (an input that faults) and the one servo period that sees it; whether
+// motion.fault is TRUE then.
+bool trips(MotionMachine& m, const std::string& setp) {
+    m.run(setp);
+    m.run("advance 0.001");
+    return m.bit("motion.fault");
+}
+
+// X's positive limit switch closes 0.1 s in: in the middle of the G1 (100 mm/s from X0 to X100,
+// line 2), or, in an instance without program= and canon= (nothing to plan, so no planner
+// thread; a thread of its own polls for faults from start to stop, where the old motion sent
+// them only at stop), with the machine enabled at rest. A limit fault names no line (the
+// switch is the machine's, whatever runs).
+class LimitSwitchText : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(LimitSwitchText, ArrivesWhileTheMachineIsLoaded) {
+    MotionMachine m(GetParam());
     m.run("advance 0.1");
     EXPECT_FALSE(m.drain()) << "an end record before any fault";
-    m.run("setp joint.0.pos-lim-sw-in TRUE");
-    m.run("advance 0.001");  // the servo period that sees the switch
-    ASSERT_TRUE(m.bit("motion.fault"));
+    ASSERT_TRUE(trips(m, "setp joint.0.pos-lim-sw-in TRUE"));
     expect_end_record(
         m, "",
         "joint 0 hit its positive limit switch (joint.0.pos-lim-sw-in); motion stopped, "
         "program abandoned");
     expect_once_after_stop(m);
 }
+
+INSTANTIATE_TEST_SUITE_P(MotionFaultMessages, LimitSwitchText,
+                         ::testing::Values("G90 G21\nG1 X100 F6000\nM30\n", ""),
+                         [](const auto& info) {
+                             return std::string(*info.param ? "ProgramRunning" : "NoProgram");
+                         });
 
 // joint.0.motor-pos-fb is not connected (0), so joint 0's following error is its command.
 // From rest at 990 mm/s^2 (1000 less the planner's 1 % override reserve; jerk unlimited) X is
@@ -190,9 +207,7 @@ TEST(MotionFaultMessages, EStopAfterTheProgramEndedArrivesWhileLoaded) {
     m.run("start");
     m.run("advance 0.01");
     EXPECT_FALSE(m.drain()) << "an end record before any fault";
-    m.run("setp iocontrol.0.emc-enable-in FALSE");
-    m.run("advance 0.001");
-    ASSERT_TRUE(m.bit("motion.fault"));
+    ASSERT_TRUE(trips(m, "setp iocontrol.0.emc-enable-in FALSE"));
     expect_end_record(
         m, "", "e-stop: iocontrol.0.emc-enable-in went FALSE; motion stopped, program abandoned");
     expect_once_after_stop(m);
@@ -209,23 +224,6 @@ TEST(MotionFaultMessages, WaitTimeoutArrivesBeforeStopAndOnce) {
     expect_once_after_stop(m);
 }
 
-// No program= and no canon=: the instance plans nothing and has no planner thread, but a
-// thread of its own polls for faults from start to stop (the old motion sent this only at
-// stop). A limit switch closing while the machine is enabled at rest trips.
-TEST(MotionFaultMessages, InstanceWithoutProgramSendsItsFaultWhileRunning) {
-    MotionMachine m("");
-    m.run("advance 0.01");
-    EXPECT_FALSE(m.drain()) << "an end record before any fault";
-    m.run("setp joint.2.neg-lim-sw-in TRUE");
-    m.run("advance 0.001");
-    ASSERT_TRUE(m.bit("motion.fault"));
-    expect_end_record(
-        m, "",
-        "joint 2 hit its negative limit switch (joint.2.neg-lim-sw-in); motion stopped, "
-        "program abandoned");
-    expect_once_after_stop(m);
-}
-
 // Each fault is sent, not only the first: a drive fault on X in the G1 (line 2, 0.1 s in), a
 // limit switch of joint 1 during its stop ramp (from about 99 mm/s at 1000 mm/s^2, about
 // 0.1 s: still running 2 ms later), and, after a reset (motion.enable falls and rises, the
@@ -234,9 +232,7 @@ TEST(MotionFaultMessages, InstanceWithoutProgramSendsItsFaultWhileRunning) {
 TEST(MotionFaultMessages, EveryFaultIsSentNotOnlyTheFirst) {
     MotionMachine m("G90 G21\nG1 X100 F6000\nM30\n");
     m.run("advance 0.1");
-    m.run("setp joint.0.amp-fault-in TRUE");
-    m.run("advance 0.001");
-    ASSERT_TRUE(m.bit("motion.fault"));
+    ASSERT_TRUE(trips(m, "setp joint.0.amp-fault-in TRUE"));
     expect_end_record(m, "",
                       "joint 0 drive fault (joint.0.amp-fault-in); motion stopped, program "
                       "abandoned");
@@ -258,9 +254,7 @@ TEST(MotionFaultMessages, EveryFaultIsSentNotOnlyTheFirst) {
     m.run("advance 0.01");
     ASSERT_FALSE(m.bit("motion.fault")) << "not reset";
     EXPECT_EQ(m.take(), 2u) << "an end record without a fault";
-    m.run("setp iocontrol.0.emc-enable-in FALSE");
-    m.run("advance 0.001");
-    ASSERT_TRUE(m.bit("motion.fault"));
+    ASSERT_TRUE(trips(m, "setp iocontrol.0.emc-enable-in FALSE"));
     expect_end_record(
         m, "", "e-stop: iocontrol.0.emc-enable-in went FALSE; motion stopped, program abandoned",
         3);
