@@ -210,14 +210,7 @@ void register_function(Instance& owner, std::string_view suffix, RealtimeFn fn, 
     rt.functs_[full] = std::make_unique<Funct>(
         Funct{full, fn, batch, object, uses_fp, ctx.component, {}, timing});
     ctx.building->functs.push_back(full);
-    for (auto [field, pname] : {std::pair{offsetof(FunctTiming, time_ns), "time"},
-                                std::pair{offsetof(FunctTiming, tmax_ns), "tmax"}}) {
-        auto param = fmt::format("{}.{}", full, pname);
-        rt.params_[param] = std::make_unique<ParamRecord>(ParamRecord{
-            param, Type::S64, field == offsetof(FunctTiming, tmax_ns) ? ParamDir::RW : ParamDir::RO,
-            ctx.component, timing + field, true});
-        ctx.building->params.push_back(param);
-    }
+    rt.add_funct_timing(*rt.functs_[full], *ctx.building);
     ctx.has_functions = true;
 }
 
@@ -240,6 +233,7 @@ void register_shared_function(Instance& owner, std::string_view name, RealtimeFn
                                                          comp.shared_functs.back().get(), uses_fp, &comp, {},
                                                          timing});
         ctx.building->functs.push_back(full);
+        rt.add_funct_timing(*rt.functs_[full], *ctx.building);
     }
     ctx.has_functions = true;
 }
@@ -1222,6 +1216,36 @@ void Runtime::cmd_stype(const std::vector<std::string>& a, std::string& out) {
 
 // Threads and functions ----------------------------------------------------------------------------
 
+void Runtime::add_time_pin(const std::string& name, Component* owner, void** field, std::uint64_t cell) {
+    if (pins_.count(name)) throw Error(fmt::format("duplicate pin '{}'", name));
+    auto* c = segment_->at<PinCell>(cell);
+    c->own.u64 = 0;
+    c->data_offset.store(segment_->offset_of(&c->own));
+    *field = &c->own;
+    pins_[name] = std::make_unique<Pin>(Pin{name, Type::S32, Dir::Out, owner, field, cell, nullptr});
+}
+
+void Runtime::add_funct_timing(Funct& f, LoadTransaction& building) {
+    const auto pin = f.name + ".time";
+    add_time_pin(pin, f.component, &f.time_pin, building.allocate(sizeof(PinCell)));
+    building.pins.push_back(pin);
+    auto* timing = segment_->at<FunctTiming>(f.timing);
+    *timing = FunctTiming{};
+    struct P {
+        const char* suffix;
+        std::size_t offset;
+        Type type;
+        ParamDir dir;
+    };
+    for (auto p : {P{"tmax", offsetof(FunctTiming, tmax), Type::S32, ParamDir::RW},
+                   P{"tmax-increased", offsetof(FunctTiming, tmax_increased), Type::Bit, ParamDir::RO}}) {
+        auto name = fmt::format("{}.{}", f.name, p.suffix);
+        if (params_.count(name)) throw Error(fmt::format("duplicate parameter '{}'", name));
+        params_[name] = std::make_unique<ParamRecord>(ParamRecord{name, p.type, p.dir, f.component, f.timing + p.offset, true});
+        building.params.push_back(name);
+    }
+}
+
 Thread& Runtime::create_thread(const std::string& name, std::int64_t period_ns, bool fp, int cpu) {
     check_item_name(name);
     if (threads_.count(name)) throw Error(fmt::format("thread '{}' already exists", name));
@@ -1229,6 +1253,8 @@ Thread& Runtime::create_thread(const std::string& name, std::int64_t period_ns, 
     if (cpu >= 0 && cpu >= static_cast<int>(std::thread::hardware_concurrency()))
         throw Error(fmt::format("thread '{}': cpu={} but this machine has {} cpus", name, cpu,
                                 std::thread::hardware_concurrency()));
+    const auto time_pin = name + ".time";
+    if (pins_.count(time_pin)) throw Error(fmt::format("thread '{}': pin '{}' already exists", name, time_pin));
     auto stats_off = segment_->allocate(sizeof(ThreadStats));
     auto* stats = segment_->at<ThreadStats>(stats_off);
     // Simulated time reads no clock, so nothing is sampled unless asked for.
@@ -1241,8 +1267,7 @@ Thread& Runtime::create_thread(const std::string& name, std::int64_t period_ns, 
         Type type;
         ParamDir dir;
     };
-    for (auto p : {P{"time", offsetof(ThreadStats, time_ns), Type::S64, ParamDir::RO},
-                   P{"tmax", offsetof(ThreadStats, tmax_ns), Type::S64, ParamDir::RW},
+    for (auto p : {P{"tmax", offsetof(ThreadStats, tmax), Type::S32, ParamDir::RW},
                    P{"wakeup-err", offsetof(ThreadStats, wakeup_err_ns), Type::S64, ParamDir::RO},
                    P{"wakeup-err-max", offsetof(ThreadStats, wakeup_max_ns), Type::S64, ParamDir::RW},
                    P{"late-cycles", offsetof(ThreadStats, late_cycles), Type::U64, ParamDir::RO},
@@ -1251,6 +1276,7 @@ Thread& Runtime::create_thread(const std::string& name, std::int64_t period_ns, 
         auto pname = fmt::format("{}.{}", name, p.suffix);
         params_[pname] = std::make_unique<ParamRecord>(ParamRecord{pname, p.type, p.dir, nullptr, stats_off + p.offset, true});
     }
+    add_time_pin(time_pin, nullptr, t->time_pin_field(), segment_->allocate(sizeof(PinCell)));
     auto& ref = *t;
     thread_order_.push_back(t.get());
     threads_[name] = std::move(t);
@@ -1284,8 +1310,13 @@ void Runtime::cmd_delthread(const std::vector<std::string>& a, std::string& out)
     Thread& t = find_thread(a[0]);
     t.stop();
     for (Funct* f : t.functs()) f->users.erase(std::remove(f->users.begin(), f->users.end(), &t), f->users.end());
-    for (const char* suffix : {"time", "tmax", "wakeup-err", "wakeup-err-max", "late-cycles", "cycles", "funct-sample"})
+    for (const char* suffix : {"tmax", "wakeup-err", "wakeup-err-max", "late-cycles", "cycles", "funct-sample"})
         params_.erase(fmt::format("{}.{}", t.name(), suffix));
+    if (auto it = pins_.find(t.name() + ".time"); it != pins_.end()) {
+        if (it->second->signal) unlink(*it->second);
+        segment_->release(it->second->cell, sizeof(PinCell));
+        pins_.erase(it);
+    }
     thread_order_.erase(std::remove(thread_order_.begin(), thread_order_.end(), &t), thread_order_.end());
     threads_.erase(a[0]);
 }

@@ -58,10 +58,13 @@ struct Signal {
     Pin* writer() const;
 };
 
-// Per-function timing, written by the thread that samples it (the RT side only stores).
+// Per-function timing params, written by the thread that samples the function (the RT side
+// only stores). Each field is one param slot: `<funct>.tmax` (s32, ns, saturated at
+// INT32_MAX; setp 0 resets it) and `<funct>.tmax-increased` (bit: the last timed call raised
+// tmax). `<funct>.time` is a pin, so it lives in its own cell or a signal (Funct::time_pin).
 struct FunctTiming {
-    std::int64_t time_ns;
-    std::int64_t tmax_ns;
+    Value tmax;
+    Value tmax_increased;
 };
 
 struct Funct {
@@ -73,6 +76,9 @@ struct Funct {
     Component* component;
     std::vector<Thread*> users;
     std::uint64_t timing;  // FunctTiming offset in the segment
+    // Where the `<funct>.time` pin's value lives now (an s32 slot: its own, or its signal's);
+    // retargeted by link/unlink, read by the thread that times the function.
+    void* time_pin = nullptr;
 };
 
 // State of one instance of a loaded component (DESIGN: loaded -> configured -> running <->
@@ -245,6 +251,12 @@ private:
                     const std::vector<std::pair<std::string, std::int64_t>>& threads);
     void unload_component(Component& c);
     Thread& create_thread(const std::string& name, std::int64_t period_ns, bool fp, int cpu);
+    // LinuxCNC's timing objects (docs/hal.md, Threads): `<name>.time`, an s32 output pin in
+    // `cell` (allocated by the caller, so a loadrt transaction can take it back) whose current
+    // storage the thread runner follows through `field`; a thread's has no owner component.
+    void add_time_pin(const std::string& name, Component* owner, void** field, std::uint64_t cell);
+    // A function's `.time` pin, `.tmax` and `.tmax-increased` params, undone with `building`.
+    void add_funct_timing(Funct& f, LoadTransaction& building);
 
     std::string resolve(const std::string& name) const;  // alias -> real name
     Pin& find_pin(const std::string& name) const;

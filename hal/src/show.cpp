@@ -49,7 +49,8 @@ void Runtime::show_pins(const std::vector<std::string>& pats, std::string& out) 
     out += fmt::format("{:>6}  {:<5} {:<4} {:>18}  {}\n", "Owner", "Type", "Dir", "Value", "Name");
     for (auto& [name, p] : pins_) {
         if (!name_matches(pats, name)) continue;
-        out += fmt::format("{:>6}  {:<5} {:<4} {:>18}  {}", p->component->id, to_string(p->type),
+        // A thread's `.time` pin has no owner component (LinuxCNC's is its threads module).
+        out += fmt::format("{:>6}  {:<5} {:<4} {:>18}  {}", p->component ? p->component->id : 0, to_string(p->type),
                            to_string(p->dir), format_value(p->type, read_pin(*p), true), name);
         if (p->signal) out += fmt::format(" {} {}", arrow(p->dir), p->signal->name);
         out += "\n";
@@ -114,7 +115,7 @@ void Runtime::show_threads(const std::vector<std::string>& pats, std::string& ou
             return histogram_bucket_floor(kHistogramBuckets - 1);
         };
         out += fmt::format("{:>11}  {:<3}  {:<20} ({:>9}, {:>9} ) {} {} {} {}, {}\n", t->period_ns(),
-                           t->uses_fp() ? "YES" : "NO", t->name(), st.time_ns, st.tmax_ns, percentile(0.5),
+                           t->uses_fp() ? "YES" : "NO", t->name(), t->time_ns(), st.tmax.s32, percentile(0.5),
                            percentile(0.99), percentile(0.999), st.wakeup_max_ns, st.late_cycles);
         int n = 1;
         for (Funct* f : t->functs()) out += fmt::format("{:>19} {}\n", n++, f->name);

@@ -31,7 +31,19 @@ template <class T>
 T get(T& field) noexcept {
     return std::atomic_ref<T>(field).load(std::memory_order_relaxed);
 }
+// The s32 slot a timing pin points at now (link/unlink retarget it under the config lock).
+std::int32_t* pin_slot(void*& field) noexcept {
+    return static_cast<std::int32_t*>(std::atomic_ref<void*>(field).load(std::memory_order_relaxed));
+}
 }  // namespace
+
+bool publish_time(void*& time_pin, Value& tmax, std::int64_t elapsed_ns) noexcept {
+    const std::int32_t t = saturate_s32(elapsed_ns);
+    put(*pin_slot(time_pin), t);
+    const bool grew = t > get(tmax.s32);
+    if (grew) put(tmax.s32, t);
+    return grew;
+}
 
 int histogram_bucket(std::int64_t ns) noexcept {
     if (ns < 8) return ns < 0 ? 0 : static_cast<int>(ns);
@@ -56,10 +68,15 @@ Thread::Thread(std::string name, std::int64_t period_ns, bool uses_fp, int cpu, 
 
 Thread::~Thread() { stop(); }
 
+std::int32_t Thread::time_ns() const noexcept {
+    auto* slot = static_cast<std::int32_t*>(std::atomic_ref<void*>(time_pin_).load(std::memory_order_relaxed));
+    return slot ? std::atomic_ref<std::int32_t>(*slot).load(std::memory_order_relaxed) : 0;
+}
+
 void Thread::set_functs(std::vector<Funct*> functs, const Segment& segment) {
     auto list = std::make_unique<List>();
     for (Funct* f : functs)
-        list->entries.push_back({f->fn, f->object, segment.at<FunctTiming>(f->timing)});
+        list->entries.push_back({f->fn, f->object, segment.at<FunctTiming>(f->timing), &f->time_pin});
     // Group runs first (recording where each starts), then point them into the final array.
     std::vector<std::size_t> starts;
     for (std::size_t i = 0; i < functs.size(); ++i) {
@@ -94,8 +111,7 @@ void Thread::run_functions(bool timed) noexcept {
     for (const Entry& e : list->entries) {
         e.fn(e.object, period);
         std::int64_t t1 = monotonic_ns();
-        put(e.timing->time_ns, t1 - t0);
-        if (t1 - t0 > get(e.timing->tmax_ns)) put(e.timing->tmax_ns, t1 - t0);
+        put(e.timing->tmax_increased.b, publish_time(*e.time_pin, e.timing->tmax, t1 - t0));
         t0 = t1;
     }
 }
@@ -169,8 +185,7 @@ void Thread::loop() noexcept {
         put(stats_->cycles, cycle);
 
         const std::int64_t done = monotonic_ns();
-        put(stats_->time_ns, done - woke);
-        if (done - woke > get(stats_->tmax_ns)) put(stats_->tmax_ns, done - woke);
+        publish_time(time_pin_, stats_->tmax, done - woke);
         // Deadlines already past are skipped, not run back to back: a late cycle must not
         // turn into a burst of catch-up cycles.
         if (done >= deadline + period_ns_) {

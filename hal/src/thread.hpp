@@ -24,10 +24,20 @@ inline constexpr int kHistogramBuckets = 8 + 41 * 8;
 int histogram_bucket(std::int64_t ns) noexcept;
 std::int64_t histogram_bucket_floor(int bucket) noexcept;
 
-// Lives in the shared segment; each 8-byte field doubles as a param slot.
+// LinuxCNC publishes execution times as s32; ours are nanoseconds, which overflow an s32 past
+// 2.147 s: such a time reads INT32_MAX rather than wrapping to a negative number.
+constexpr std::int32_t saturate_s32(std::int64_t ns) noexcept {
+    return ns > INT32_MAX ? INT32_MAX : ns < INT32_MIN ? INT32_MIN : static_cast<std::int32_t>(ns);
+}
+// Realtime: one measured execution time into a `.time` pin (whose current s32 slot `time_pin`
+// points at) and its `.tmax` param, by LinuxCNC's rule (tmax follows the largest time seen);
+// returns whether tmax grew, which is what `<funct>.tmax-increased` shows.
+bool publish_time(void*& time_pin, Value& tmax, std::int64_t elapsed_ns) noexcept;
+
+// Lives in the shared segment; each 8-byte field doubles as a param slot. The last execution
+// time is the `<thread>.time` pin, not a field here (see Thread::time_pin_field).
 struct ThreadStats {
-    std::int64_t time_ns;          // last execution time
-    std::int64_t tmax_ns;          // max execution time (rw: write 0 to reset)
+    Value tmax;                    // s32 ns, saturated: max execution time (rw: write 0 to reset)
     std::int64_t wakeup_err_ns;    // last wake-up error (now - deadline)
     std::int64_t wakeup_max_ns;
     std::uint64_t late_cycles;     // deadlines missed and skipped, never replayed
@@ -49,6 +59,10 @@ public:
     int cpu() const noexcept { return cpu_; }
     const std::vector<Funct*>& functs() const noexcept { return functs_; }
     ThreadStats& stats() const noexcept { return *stats_; }
+    // The `<thread>.time` pin's current storage (s32 ns), retargeted through this field by
+    // link/unlink; null until the runtime registers the pin.
+    void** time_pin_field() noexcept { return &time_pin_; }
+    std::int32_t time_ns() const noexcept;
 
     // Configuration world: replaces the function list; a running thread picks it up at its
     // next cycle (the old list stays alive until the thread stops).
@@ -72,6 +86,7 @@ private:
         RealtimeFn fn;
         void* object;
         struct FunctTiming* timing;
+        void** time_pin;  // &Funct::time_pin
     };
     // A run of consecutive entries calling the same batchable function: one call for all.
     struct Run {
@@ -93,6 +108,7 @@ private:
     bool uses_fp_;
     int cpu_;
     ThreadStats* stats_;
+    mutable void* time_pin_ = nullptr;  // see time_pin_field()
     std::vector<Funct*> functs_;
     std::atomic<const List*> active_{nullptr};
     std::vector<std::unique_ptr<List>> lists_;  // current and retired lists

@@ -21,8 +21,8 @@
 
 namespace {
 
-// The thread's statistics block is found through its first param ("<thread>.time").
-static_assert(offsetof(hal::ThreadStats, time_ns) == 0);
+// The thread's statistics block is found through its first param ("<thread>.tmax").
+static_assert(offsetof(hal::ThreadStats, tmax) == 0);
 
 struct Settings {
     bench::ChainSpec chain;
@@ -104,7 +104,7 @@ SimResult measure_sim(const Settings& s) {
     return r;
 }
 
-// Real-time thread: the thread measures its own cycle (`<thread>.time`, ns); we read it with
+// Real-time thread: the thread measures its own cycle (`<thread>.time` pin, ns); we read it with
 // getp once per new cycle. Also returns the thread's wake-up histogram for (b).
 struct RtResult {
     std::vector<double> cycle_ns;
@@ -131,12 +131,12 @@ RtResult sample_thread(hal::Runtime& rt, const std::string& thread, double secon
         r.wakeup_sampled_ns.push_back(static_cast<double>(getp_int(rt, thread + ".wakeup-err")));
     }
     run(rt, "stop");
-    const auto& stats = *rt.segment().at<hal::ThreadStats>(rt.lookup(thread + ".time").offset);
+    const auto& stats = *rt.segment().at<hal::ThreadStats>(rt.lookup(thread + ".tmax").offset);
     r.histogram.assign(std::begin(stats.histogram), std::end(stats.histogram));
     r.wakeup_max_ns = stats.wakeup_max_ns;
     r.cycles = stats.cycles;
     r.late_cycles = stats.late_cycles;
-    r.tmax_ns = stats.tmax_ns;
+    r.tmax_ns = stats.tmax.s32;
     return r;
 }
 

@@ -60,7 +60,8 @@ TEST_F(ClientTest, RemoteCommandsReturnOutputAndErrors) {
         EXPECT_EQ(std::string(e.what()), "pin or parameter 'tprobe.0.nope' does not exist");
     }
     auto pins = remote.names("pin");
-    EXPECT_EQ(pins.size(), 12u);  // 6 inputs, 2 outputs, io, cycles, 2 taps
+    // 6 inputs, 2 outputs, io, cycles, 2 taps, and the `.time` of tprobe.0 and tprobe.tick-all
+    EXPECT_EQ(pins.size(), 14u);
 }
 
 TEST_F(ClientTest, StreamRecordsCrossProcessesInOrder) {

@@ -79,7 +79,8 @@ TEST_F(Rt, AFailedConstructorLeavesNothingBehind) {
     EXPECT_EQ(run("list funct"), "\n");
     EXPECT_EQ(run("list comp"), "\n");
     run("loadrt tfailing count=3");  // the storage the failed load took is reused
-    EXPECT_EQ(run("list pin tfailing.2"), "tfailing.2.a tfailing.2.b\n");
+    // The function's `.time` pin too, as LinuxCNC gives every function one.
+    EXPECT_EQ(run("list pin tfailing.2"), "tfailing.2.a tfailing.2.b tfailing.2.time\n");
     EXPECT_EQ(run("list pin fixed"), "fixed.0.b fixed.1.b fixed.2.b\n");  // '=' names are unprefixed
     EXPECT_LE(rt->segment().bytes_in_use(), before + 3 * 1024);
 }
@@ -214,7 +215,7 @@ TEST_F(Rt, UnloadRemovesEverythingAndFreesStorage) {
     run("addf tprobe.0 t");
     auto used = rt->segment().bytes_in_use();
     run("unload tprobe");
-    EXPECT_EQ(run("list pin"), "\n");
+    EXPECT_EQ(run("list pin"), "t.time\n");  // only the thread's own pin is left
     EXPECT_EQ(run("list funct"), "\n");
     EXPECT_EQ(run("show thread t").find("tprobe"), std::string::npos);
     EXPECT_EQ(run("list sig"), "v\n");  // signals outlive their pins, as in LinuxCNC

@@ -47,16 +47,22 @@ struct Failing : hal::Instance {
 struct Spinner : hal::Instance {
     hal::Param<std::int64_t> spin_ns{this, "spin-ns", 0};
     hal::Out<std::uint64_t> calls{this, "calls"};
+    // TRUE while a spin is under way, so a test can stop the thread inside that very cycle.
+    hal::Out<bool> spinning{this, "spinning"};
+    hal::Out<std::uint64_t> last_spin_call{this, "last-spin-call"};  // `calls` of the last spin
     std::uint64_t n = 0;
     void update(hal::Period) noexcept {
         // Busy-waits once for spin-ns, then clears it: a single deliberately late cycle.
         std::int64_t spin = spin_ns;
         if (spin > 0) {
+            spinning = true;
             timespec t0, t;
             clock_gettime(CLOCK_MONOTONIC, &t0);
             do clock_gettime(CLOCK_MONOTONIC, &t);
             while ((t.tv_sec - t0.tv_sec) * 1'000'000'000LL + (t.tv_nsec - t0.tv_nsec) < spin);
             spin_ns = 0;
+            spinning = false;
+            last_spin_call = n + 1;
         }
         calls = ++n;
     }
