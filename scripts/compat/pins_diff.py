@@ -115,16 +115,12 @@ def main():
     print("# Pins, params and functions: ours against LinuxCNC 2.9\n")
     if only_ours:
         print(f"Not in LinuxCNC (not compared): {', '.join(only_ours)}\n")
-    timing_re = re.compile(r"\.(time|tmax|tmax-increased)$")
-    print("Compared: name, type, direction and the value right after loadrt (the default).\n")
-    print("Per-function timing objects are left out below: LinuxCNC 2.9 gives every function a\n"
-          "`<funct>.time` s32 *pin* (CPU clocks), a `<funct>.tmax` s32 param and a\n"
-          "`<funct>.tmax-increased` bit param; we give a `<funct>.time` s64 *param* and a\n"
-          "`<funct>.tmax` s64 param (ns), and no tmax-increased.\n")
+    print("Compared: name, type, direction and the value right after loadrt (the default),\n"
+          "per-function timing objects (`<funct>.time`, `.tmax`, `.tmax-increased`) included.\n")
     for comp in common:
         rc1, out1, rc2, out2 = results[comp]
-        a_items = {k: v for k, v in parse_show(out1).items() if not timing_re.search(k[1])}
-        b_items = {k: v for k, v in parse_show(out2).items() if not timing_re.search(k[1])}
+        a_items = parse_show(out1)
+        b_items = parse_show(out2)
         lines = []
         # halcompile names instances after the component with '_' turned into '-'.
         dashed = comp.replace("_", "-")
