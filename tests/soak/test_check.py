@@ -1,0 +1,231 @@
+#!/usr/bin/env python3
+"""Unit tests of the soak's checks and model: each check passes a trace that keeps its rule and
+fails the same trace doctored to break it (a sample moved 0.05 mm, a velocity over the limit,
+...), so none of them can pass everything. Synthetic traces, no cnc run."""
+
+import math
+import os
+import sys
+import unittest
+
+sys.dont_write_bytecode = True  # no __pycache__ in the source tree
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import check  # noqa: E402
+from machine import AxisLimits, JointLimits, Machine  # noqa: E402
+from program import Model, generate, model_of  # noqa: E402
+
+T = 1e-3
+
+
+def machine(vel=100.0, acc=1000.0, jerk=20000.0, kins="kins_trivial"):
+    axes = {l: AxisLimits(0.0, 400.0, vel, acc, jerk) for l in "xyz"}
+    joints = [JointLimits(0.0, 400.0, 1000.0) for _ in range(3)]
+    return Machine("test.ini", "test", "xyz", axes, joints, T, 0.01, kins, "test.var", {})
+
+
+def trace_of(points, lines=None):
+    n = len(points)
+    return check.Trace([], [(k + 1) * T for k in range(n)], lines or [1] * n, [list(p) for p in points],
+                       [list(p) for p in points])
+
+
+def smooth_move(a, b, duration_s):
+    """Rest to rest from a to b: s(t) = L (t/D - sin(2 pi t/D) / 2 pi), then held 5 periods."""
+    steps = round(duration_s / T)
+    pts = []
+    for k in range(1, steps + 1):
+        f = k / steps - math.sin(2 * math.pi * k / steps) / (2 * math.pi)
+        pts.append([round(x + (y - x) * f, 6) for x, y in zip(a, b)])
+    return pts + [list(b)] * 5
+
+
+class PathCheck(unittest.TestCase):
+    def setUp(self):
+        self.m = machine()
+        # Exact path (G61): the corner at (10, 0) is stopped at, tolerance 0 everywhere.
+        self.model = model_of(["G61 F600", "G1 X10", "G1 Y10", "M30"], self.m)
+        self.pts = smooth_move([0, 0, 0], [10, 0, 0], 1.0) + smooth_move([10, 0, 0], [10, 10, 0], 1.0)
+
+    def test_on_the_path_passes(self):
+        self.assertIsNone(check.check_path(trace_of(self.pts), self.model))
+
+    def test_a_sample_moved_off_the_path_fails(self):
+        pts = [list(p) for p in self.pts]
+        pts[500][1] += 0.05
+        f = check.check_path(trace_of(pts), self.model)
+        self.assertIsNotNone(f)
+        self.assertEqual(f.check, "path")
+        self.assertAlmostEqual(f.trace_t_s, 0.501)
+        # On an exact path only the rounding of the printed numbers is allowed: sqrt(3) * 0.5e-6 mm.
+        pts[500][1] = self.pts[500][1] + 0.8e-6
+        self.assertIsNone(check.check_path(trace_of(pts), self.model))
+        pts[500][1] = self.pts[500][1] + 1.2e-6
+        self.assertIsNotNone(check.check_path(trace_of(pts), self.model))
+
+    def test_within_the_blend_tolerance_passes(self):
+        model = model_of(["G64 P0.05 F600", "G1 X10", "G1 Y10", "M30"], self.m)
+        pts = [list(p) for p in self.pts]
+        pts[500][1] += 0.049  # the tolerance of the corner at its end applies along the move
+        self.assertIsNone(check.check_path(trace_of(pts), model))
+        pts[500][1] += 0.002
+        self.assertIsNotNone(check.check_path(trace_of(pts), model))
+
+    def test_running_the_path_backwards_fails(self):
+        f = check.check_path(trace_of(list(reversed(self.pts))), self.model)
+        self.assertIsNotNone(f)
+
+    def test_stopping_short_fails(self):
+        f = check.check_path(trace_of(self.pts[:-600]), self.model)
+        self.assertIsNotNone(f)
+        self.assertIn("ends at", f.detail)
+
+    def test_arc_and_helix_distances(self):
+        model = model_of(["F600", "G0 X20 Y10", "G3 X10 Y20 Z-3 I-10 J0", "M30"], self.m)
+        arc = model.elements[-1]
+        self.assertIsNotNone(arc.arc)
+        for f in (0.0, 0.3, 0.77, 1.0):
+            self.assertLess(check.distance(arc, arc.point(f)), 1e-9)
+        p = arc.point(0.5)  # 45 degrees on the circle about (10, 10): move outward 0.05 mm
+        q = [p[0] + 0.05 / math.sqrt(2), p[1] + 0.05 / math.sqrt(2), p[2]]
+        self.assertAlmostEqual(check.distance(arc, q), 0.05, delta=0.05 * 0.01)
+
+
+class LimitChecks(unittest.TestCase):
+    def test_velocity_at_the_limit_passes_above_fails(self):
+        m = machine(jerk=0, acc=1e9)
+        at = [[0.1 * k, 0, 0] for k in range(1, 50)]  # 100 mm/s on X
+        self.assertIsNone(check.check_axis_limits(trace_of(at), m, [0, 0, 0]))
+        over = [[round(0.100003 * k, 6), 0, 0] for k in range(1, 50)]  # 100.003 mm/s
+        f = check.check_axis_limits(trace_of(over), m, [0, 0, 0])
+        self.assertIsNotNone(f)
+        self.assertEqual(f.check, "velocity")
+
+    def test_one_velocity_step_over_the_limit_fails(self):
+        m = machine()
+        pts = smooth_move([0, 0, 0], [10, 0, 0], 0.5)  # peak 40 mm/s
+        self.assertIsNone(check.check_axis_limits(trace_of(pts), machine(vel=40.001), [0, 0, 0]))
+        self.assertIsNotNone(check.check_axis_limits(trace_of(pts), machine(vel=39.99), [0, 0, 0]))
+        # One sample moved 0.05 mm: a 50 mm/s velocity step, far beyond 1000 mm/s^2.
+        pts[200][0] += 0.05
+        f = check.check_axis_limits(trace_of(pts), m, [0, 0, 0])
+        self.assertIsNotNone(f)
+        self.assertEqual(f.check, "acceleration")
+
+    def test_acceleration_bound_includes_the_rounding(self):
+        m = machine(jerk=0)
+        # Constant acceleration a from rest: positions a T^2 k^2 / 2, rounded to 6 decimals.
+        def ramp(a):
+            return [[round(a * (k * T) ** 2 / 2, 6), 0, 0] for k in range(1, 100)]
+        self.assertIsNone(check.check_axis_limits(trace_of(ramp(1000.0)), m, [0, 0, 0]))
+        f = check.check_axis_limits(trace_of(ramp(1004.0)), m, [0, 0, 0])
+        self.assertIsNotNone(f)
+        self.assertEqual(f.check, "acceleration")
+
+    def test_jerk(self):
+        def cubic(j):
+            return [[round(j * (k * T) ** 3 / 6, 6), 0, 0] for k in range(1, 40)]
+        self.assertIsNone(check.check_axis_limits(trace_of(cubic(20000.0)), machine(), [0, 0, 0]))
+        # The rounding allowance is 4000 mm/s^3 at 1 kHz: 24100 is over it.
+        f = check.check_axis_limits(trace_of(cubic(24100.0)), machine(), [0, 0, 0])
+        self.assertIsNotNone(f)
+        self.assertEqual(f.check, "jerk")
+        self.assertIsNone(check.check_axis_limits(trace_of(cubic(24100.0)), machine(jerk=0), [0, 0, 0]))
+
+    def test_joint_limits(self):
+        m = machine()
+        tr = trace_of([[1, 1, 1], [0.0005, 1, 1]])
+        self.assertIsNone(check.check_joint_limits(tr, m))
+        tr.joints[1][0] = -0.0025  # past 0 by more than one encoder count (0.001 mm)
+        f = check.check_joint_limits(tr, m)
+        self.assertIsNotNone(f)
+        self.assertEqual(f.check, "joint-limit")
+
+
+class RunReport(unittest.TestCase):
+    SUMMARY = "result: finished\nfinal position (mm): x 10.0000  y 5.0000  z -1.2346\nerrors: none\n"
+
+    def test_exit_and_summary(self):
+        self.assertIsNone(check.check_exit(0, self.SUMMARY))
+        self.assertEqual(check.check_exit(1, self.SUMMARY).check, "exit")
+        self.assertEqual(check.check_exit(0, self.SUMMARY.replace("none", "x.ngc:3: boom")).check, "summary")
+        self.assertEqual(check.check_exit(0, self.SUMMARY.replace("finished", "fault")).check, "summary")
+
+    def test_end_point(self):
+        m = machine()
+        model = Model("xyz", 0.01)
+        model.pos = [10.0, 5.0, -1.23456]
+        self.assertIsNone(check.check_end_point(self.SUMMARY, model, m))
+        model.pos = [10.0, 5.0002, -1.23456]
+        self.assertEqual(check.check_end_point(self.SUMMARY, model, m).check, "end-point")
+
+    def test_stderr(self):
+        mill, trt = machine(), machine(kins="kins_xyzac_trt")
+        excess = ("motion.0: joint 0 was commanded a velocity of 120/s in 3 periods (first at line 5), "
+                  "above motion.0.joint.0.max-velocity = 100: the kinematics ask more of this motor "
+                  "than the axis limits allow")
+        self.assertIsNone(check.check_stderr("", mill))
+        self.assertIsNone(check.check_stderr(excess, trt))
+        self.assertEqual(check.check_stderr(excess, mill).check, "stderr")
+        self.assertEqual(check.check_stderr("prog.ngc:3:1: warning: odd", trt).check, "stderr")
+        stale = "halrun: removed stale HAL instance 'cnc-run-27728' left by dead process 27728"
+        self.assertIsNone(check.check_stderr(stale, mill))
+
+    def test_lines_and_numbers(self):
+        tr = trace_of([[0, 0, 0]] * 4, lines=[1, 2, 2, 3])
+        self.assertIsNone(check.check_lines(tr))
+        tr.line[2] = 1
+        self.assertEqual(check.check_lines(tr).check, "line-order")
+        self.assertIsNone(check.check_numbers(tr))
+        tr.axes[3][1] = float("nan")
+        self.assertEqual(check.check_numbers(tr).check, "nan")
+
+
+class ModelGeometry(unittest.TestCase):
+    """The model's own reading of the subset, against geometry worked by hand."""
+
+    def test_radius_arcs(self):
+        m = machine()
+        short_ccw = model_of(["F600", "G3 X5 Y5 R5", "M30"], m).elements[0].arc
+        self.assertAlmostEqual(short_ccw[2], 0.0)  # centre (0, 5): start at -90 deg, end at 0
+        self.assertAlmostEqual(short_ccw[3], 5.0)
+        self.assertAlmostEqual(short_ccw[6], math.pi / 2)
+        short_cw = model_of(["F600", "G2 X5 Y5 R5", "M30"], m).elements[0].arc
+        self.assertAlmostEqual(short_cw[2], 5.0)  # centre (5, 0): from 180 deg to 90 deg clockwise
+        self.assertAlmostEqual(short_cw[3], 0.0)
+        self.assertAlmostEqual(short_cw[6], -math.pi / 2)
+        long_ccw = model_of(["F600", "G3 X5 Y5 R-5", "M30"], m).elements[0].arc
+        self.assertAlmostEqual(long_ccw[6], 1.5 * math.pi)
+
+    def test_planes(self):
+        m = machine()
+        # G18: the plane is (Z, X), CCW turns Z towards X; from Z=0 X=10 about the origin
+        # to X=0 Z=10 is a quarter turn... clockwise in (Z, X) coordinates.
+        arc = model_of(["F600", "G0 X10", "G18 G2 X0 Z10 I-10 K0", "M30"], m).elements[-1]
+        self.assertEqual(arc.arc[:2], (2, 0))
+        self.assertAlmostEqual(arc.arc[6], -math.pi / 2)
+        self.assertAlmostEqual(arc.point(0.5)[0], 10 / math.sqrt(2))
+        self.assertAlmostEqual(arc.point(0.5)[2], 10 / math.sqrt(2))
+
+    def test_rapid_split_and_tolerances(self):
+        m = machine()
+        model = model_of(["G0 X10 Z-5", "G0 X20 Z-1", "G64 P0.2 F600", "G1 X30", "G1 X40 G09",
+                          "G04 P10", "G61", "G1 X50", "M30"], m)
+        ends = [e.end for e in model.elements]
+        # Falling: X first, then Z; rising: Z first.
+        self.assertEqual(ends[:4], [[10, 0, 0], [10, 0, -5], [10, 0, -1], [20, 0, -1]])
+        self.assertEqual([e.tol_end_mm for e in model.elements[4:]], [0.2, 0.0, 0.0])
+        self.assertEqual(model.elements[0].tol_end_mm, 0.01)
+
+    def test_generated_programs_are_valid_for_the_model(self):
+        for seed in range(1, 30):
+            lines = generate(machine(), seed, 30)
+            model = model_of(lines, machine())
+            self.assertTrue(model.ended)
+            for e in model.elements:
+                for k, l in enumerate("xyz"):
+                    self.assertTrue(0 <= e.end[k] <= 400, (seed, e))
+
+
+if __name__ == "__main__":
+    unittest.main()
