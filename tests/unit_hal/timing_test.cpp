@@ -1,6 +1,9 @@
 // LinuxCNC 2.9's timing objects (docs/linuxcnc-compat.md, R10): every thread and function has
 // a `.time` s32 output pin and a `.tmax` s32 param, every function a `.tmax-increased` bit
 // param. Ours hold nanoseconds, saturated at INT32_MAX. Real clock: the thread must run.
+#include <pthread.h>
+#include <sched.h>
+
 #include <chrono>
 #include <climits>
 #include <cstdint>
@@ -29,11 +32,36 @@ void start_spinner_thread(Timing& f) {
     f.run("start");
 }
 
+// While it lives, the calling thread polls above the HAL threads' SCHED_FIFO priority (90)
+// when it may: with every CPU busy in a real-time spin (other tests spinning beside this one)
+// a normally scheduled poller would not run until the spins were over. Without permission the
+// HAL threads are not SCHED_FIFO either, and nothing is changed.
+class PollAboveHalThreads {
+public:
+    PollAboveHalThreads() {
+        pthread_getschedparam(pthread_self(), &policy_, &param_);
+        sched_param high{};
+        high.sched_priority = 95;
+        raised_ = pthread_setschedparam(pthread_self(), SCHED_FIFO, &high) == 0;
+    }
+    ~PollAboveHalThreads() {
+        if (raised_) pthread_setschedparam(pthread_self(), policy_, &param_);
+    }
+    PollAboveHalThreads(const PollAboveHalThreads&) = delete;
+    PollAboveHalThreads& operator=(const PollAboveHalThreads&) = delete;
+
+private:
+    int policy_ = SCHED_OTHER;
+    sched_param param_{};
+    bool raised_ = false;
+};
+
 // Stops the running thread inside a spin of `ns`: `stop` lets the cycle under way finish, so
 // the spinning call is the thread's last one and its figures are what the pins and params show.
-// On a loaded machine the poller may miss a spin, or stop the thread a cycle late; both are
-// seen and the spin is retried twice as long (so it still raises tmax).
+// On a loaded machine the poller may still miss a spin, or stop the thread a cycle late; both
+// are seen and the spin is retried twice as long (so it still raises tmax).
 bool stop_inside_spin(Timing& f, std::int64_t ns) {
+    PollAboveHalThreads poll_first;
     for (int attempt = 0; attempt < 4; ++attempt, ns *= 2) {
         f.run(fmt::format("setp tspinner.0.spin-ns {}", ns));
         bool inside = false;
