@@ -3,17 +3,21 @@
 
     bench/floor/floor.py PROGRAM --lines A-B [--step-ms 1] [--lead-in 25] [--lead-out 25]
                          [--horizon-ms MS] [--tolerance P] [--vmax 100] [--amax 1000]
+                         [--reach-vertices] [--solver highs|cbc]
 
 The floor holds for every motion that keeps the path-distance contract of docs/benchmarks.md
 ("The contract it assumes"): per-axis |v| <= V and |a| <= A, instants t_0 <= ... <= t_n with
 the tool within P_i of move S_i during [t_(i-1), t_i] and, on a feed move, no faster than F_i.
+--reach-vertices adds a stricter clause (SectionModel.reach_clauses): during [t_(i-1), t_i]
+the tool also gets within P_i of both end points of a line or rapid S_i, along it.
 The section A-B runs from t_a (the end of line A-1's move, the vertex c_a) to t_b (the end of
 line B's move); the floor bounds t_b - t_a from below.
 
 It is a discrete relaxation solved as a MILP (docs/benchmarks.md, "A numerical floor for
 sections", has the argument step by step): the samples q_k = q(t_a + k h) of any such motion
-satisfy every constraint of the MILP, so the MILP's optimum (or HiGHS's proved dual bound when
-it stops early) can only be lower than the real section time.
+satisfy every constraint of the MILP, so the MILP's optimum (or the solver's proved dual bound
+when it stops early) can only be lower than the real section time. The solver is HiGHS through
+SciPy, or COIN-OR CBC's cbc binary (--solver cbc) on the MILP written as MPS.
 
 Programs: the subset tp_default is made of: G0 G1 (X Y Z F), G2 G3 in the XY plane (G17; only
 as outer hulls, which are weak, see the docs), G64 P, G17 G21 G90, M2/M30. Anything else is
@@ -21,7 +25,12 @@ refused with FILE:LINE and the cause.
 """
 import argparse
 import math
+import os
+import resource
+import shutil
+import subprocess
 import sys
+import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -164,9 +173,11 @@ def in_model_units(moves):
 
 
 def make_model(moves, a, b, v_mm_s=100.0, a_mm_s2=1000.0, step_ms=1.0, lead_in=25,
-               lead_out=25, horizon_s=None, perp_count=8, group_turn_deg=0.0):
+               lead_out=25, horizon_s=None, perp_count=8, group_turn_deg=0.0,
+               reach_vertices=False):
     """The section model for programmed moves in mm (vertex a is the end of move a, moves
-    numbered from 1), built in model units (micrometres)."""
+    numbered from 1), built in model units (micrometres). reach_vertices: the stricter
+    contract in which every move reaches both its end points (SectionModel.reach_clauses)."""
     mv = moves_with_rest(in_model_units(moves))
     k = UNIT_PER_MM
     lim = Limits(k * (np.full(3, float(v_mm_s)) if np.isscalar(v_mm_s) else
@@ -176,7 +187,7 @@ def make_model(moves, a, b, v_mm_s=100.0, a_mm_s2=1000.0, step_ms=1.0, lead_in=2
     if horizon_s is None:
         horizon_s = default_horizon_s(mv, a, b, lim)
     return SectionModel(mv, a, b, lim, step_ms * 1e-3, lead_in, lead_out, horizon_s,
-                        perp_count, group_turn_deg)
+                        perp_count, group_turn_deg, reach_vertices)
 
 
 def moves_with_rest(moves):
@@ -357,6 +368,17 @@ def rows_box(rows_list):
     return lo, hi
 
 
+def rows_min(rows_list, n):
+    """min of n . x over the intersection of several row sets (an LP), less SLACK."""
+    A = np.array([m for rows in rows_list for m, _ in rows])
+    b = np.array([r for rows in rows_list for _, r in rows])
+    res = linprog(np.asarray(n, float), A_ub=A, b_ub=b + SLACK, bounds=[(None, None)] * 3,
+                  method="highs")
+    if res.status != 0:
+        raise RuntimeError(f"corner region LP failed: {res.message}")
+    return res.fun - SLACK
+
+
 # ----------------------------------------------------------------------------------------------
 # The problem
 
@@ -382,6 +404,7 @@ class FloorResult:
     binaries: int
     rows: int
     trajectory: list = field(default_factory=list)
+    cpu_s: float = 0.0         # CPU time of the solver(s): HiGHS in-process, cbc as a child
 
 
 class SectionModel:
@@ -389,8 +412,9 @@ class SectionModel:
     states included at 0 and n + 1)."""
 
     def __init__(self, moves, a, b, limits, step_s, lead_in, lead_out, horizon_s,
-                 perp_count=8, group_turn_deg=0.0):
+                 perp_count=8, group_turn_deg=0.0, reach_vertices=False):
         self.mv, self.a, self.b = moves, a, b
+        self.reach_vertices = reach_vertices
         # The MILP assigns samples to elements: single moves, or chains of nearly collinear
         # lines taken as the convex hull of their tubes (group_moves).
         self.el = group_moves(moves, a, b, group_turn_deg)
@@ -400,6 +424,7 @@ class SectionModel:
         # HiGHS 1.2 (SciPy 1.10) presolve declared a real motion infeasible (the soundness
         # test), so proofs run without it; --presolve turns it on for quick exploration.
         self.presolve = False
+        self.solver = "highs"   # or "cbc" (run_cbc)
         self.lim, self.h = limits, step_s
         self.k_in, self.k_out = lead_in, lead_out
         self.U = max(1, int(math.ceil(horizon_s / step_s)))  # at most U - 1 samples past t_a
@@ -472,6 +497,29 @@ class SectionModel:
                 self._direct_time(u, v)
             self._min_time[key] = max(chain, self._direct_time(u, v))
         return self._min_time[key]
+
+    # -- the stricter contract: every move reaches both its end points ----------------------
+    def reach_clauses(self):
+        """[(i, n, r)]: while move i is the current one (at some instant of [t_(i-1), t_i]) the
+        tool reaches n . x >= r (local model units): n = u_i, r = u_i . c_i - P_i (it gets to
+        within P of its end, along itself) and n = -u_i, r = -u_i . c_(i-1) - P_i (it starts
+        within P of its start). Only lines and rapids of the section; a clause that the corner
+        region at that end already implies (it holds at t_i, or at t_(i-1)) is left out, so
+        only reversals and turns sharper than about 90 degrees keep theirs."""
+        clauses = []
+        for i in range(self.a + 1, self.b + 1):
+            m = self.mv[i]
+            u = m.direction()
+            if m.kind not in ("line", "rapid") or u is None:
+                continue
+            for n, c, v in ((u, m.end, i), (-u, m.start, i - 1)):
+                r = float(np.dot(n, c - self.origin)) - m.tol_mm
+                if rows_min([self.rows(v), self.rows(v + 1)], n) < r:
+                    clauses.append((i, n, r))
+        return clauses
+
+    def el_of(self, i):
+        return next(e for e, (i0, i1) in enumerate(self.el) if i0 <= i <= i1)
 
     # -- which moves each sample may be on ------------------------------------------------
     def windows(self):
@@ -620,6 +668,8 @@ class SectionModel:
         # times the largest feed among them (nothing if a rapid is among them).
         for k0, k1 in zip(ks, ks[1:]):
             self._feed_rows(k0, k1, win, qidx, zval, vp, cons)
+        if self.reach_vertices and not self._reach_rows(ks, qidx, zval, vp, cons):
+            return beyond_horizon()
         # Objective: N = the number of samples k >= 1 not past b (s_k <= t_b).
         cost = np.zeros(vp.count)
         const = 0.0
@@ -635,33 +685,29 @@ class SectionModel:
         if mps_path is not None:
             write_mps(mps_path, np.zeros(vp.count) if feasibility else cost, vp, A, cons)
             return None
-        res = milp(np.zeros(vp.count) if feasibility else cost,
-                   integrality=np.array(vp.integer, float),
-                   bounds=Bounds(np.array(vp.lo), np.array(vp.hi)),
-                   constraints=LinearConstraint(A, np.array(cons.lo), np.array(cons.hi)),
-                   options={"time_limit": time_limit_s, "mip_rel_gap": 0.0, "disp": verbose,
-                            "presolve": self.presolve})
+        objective = np.zeros(vp.count) if feasibility else cost
+        run = run_cbc if self.solver == "cbc" else run_highs
+        ans = run(objective, vp, A, cons, time_limit_s, verbose, self.presolve)
         solve_s = time.monotonic() - t_start
-        if res.status == 2:
-            return beyond_horizon()
-        if res.status not in (0, 1):
-            raise RuntimeError(f"HiGHS: {res.message}")
-        count = (float(cost @ res.x) + const) if res.x is not None else math.nan
-        if feasibility or res.mip_dual_bound is None:
+        if ans.infeasible:
+            res = beyond_horizon()
+            res.cpu_s = ans.cpu_s
+            return res
+        count = (float(cost @ ans.x) + const) if ans.x is not None else \
+            (ans.objective + const if not feasibility and ans.found else math.nan)
+        if feasibility or ans.dual_bound is None:
             # Nothing proved by this solve beyond what the caller already knows.
-            return FloorResult(0.0, "feasible" if res.x is not None else "unknown", 0,
+            return FloorResult(0.0, "feasible" if ans.found else "unknown", 0,
                                count * h, math.nan, solve_s, h, self.U * h, vp.count,
-                               len(zidx), len(cons.lo))
+                               len(zidx), len(cons.lo), cpu_s=ans.cpu_s)
         # N is an integer, so the dual bound rounds up.
-        proved = max(0, int(math.ceil(res.mip_dual_bound + const - 1e-6)))
-        relaxed = count * h
-        gap = res.mip_gap if res.mip_gap is not None else math.nan
-        status = "optimal" if res.status == 0 else "time limit (dual bound)"
+        proved = max(0, int(math.ceil(ans.dual_bound + const - 1e-6)))
+        status = "optimal" if ans.optimal else "time limit (dual bound)"
         traj = []
-        if res.x is not None:
-            traj = [(k, (res.x[qidx[k]:qidx[k] + 3] + self.origin) / UNIT_PER_MM) for k in ks]
-        return FloorResult(proved * h, status, proved, relaxed, gap, solve_s, h, self.U * h,
-                           vp.count, len(zidx), len(cons.lo), traj)
+        if ans.x is not None:
+            traj = [(k, (ans.x[qidx[k]:qidx[k] + 3] + self.origin) / UNIT_PER_MM) for k in ks]
+        return FloorResult(proved * h, status, proved, count * h, ans.gap, solve_s, h,
+                           self.U * h, vp.count, len(zidx), len(cons.lo), traj, ans.cpu_s)
 
     def _tube_rows(self, k, window, q, zval, vp, cons):
         """Sample k lies within P_i of the element i it is on, written as the convex hull of
@@ -695,6 +741,54 @@ class SectionModel:
                 cons.add(coefs, -np.inf, rr * y_const)
         for j in range(3):
             cons.add(sums[j], 0.0, 0.0)
+
+    def _reach_rows(self, ks, qidx, zval, vp, cons):
+        """The clauses of reach_clauses on the grid. Move i reaches n . x >= r at an instant
+        tau of [t_(i-1), t_i]. Between samples, k h <= tau <= (k+1) h, n . q has a second
+        derivative of at most A_n = sum |n_j| A_j, so it exceeds its chord by at most
+        A_n h^2 / 8: the larger of n . q_k and n . q_(k+1), sample s (or tau / h itself when
+        tau is on the grid), is >= r - A_n h^2 / 8. Since 0 <= tau < t_b < U h, 0 <= s <= U.
+        A monotone binary p_k = [s <= k] marks the pick (p_(-1) = 0, p_U = 1, the pick is where
+        p steps up, with a big-M row there), tied to the assignment: (s - 1) h < tau <= t_i,
+        so a sample k past move i has k >= s (z_(k,i) <= p_k); t_(i-1) <= tau < (s + 1) h, so
+        sample k + 1 is past move i - 1 once k >= s (p_k <= z_(k+1,i-1)). False when the
+        window leaves no sample for a clause: no motion keeps it within the horizon."""
+        h, have = self.h, set(ks)
+        top = self.U
+        for i, n, r in self.reach_clauses():
+            e = self.el_of(i)
+            need = r - float(np.dot(np.abs(n), self.lim.a_mm_s2)) * h * h / 8 - SLACK
+            # p[k] as (var or None, constant) for k = -1 .. U
+            p = {-1: (None, 0.0), top: (None, 1.0)}
+            for k in range(0, top):
+                p[k] = (vp.add(1, 0.0, 1.0, integer=True), 0.0)
+            for k in range(-1, top + 1):
+                if k in have and k != 0:
+                    z, c = zval(k, e, left=False)  # z_(k,e) <= p_k
+                    if not _le(cons, vp, (z, c), p[k]):
+                        return False
+                if k + 1 in have and k + 1 != 0:
+                    z, c = zval(k + 1, e - 1, left=False)  # p_k <= z_(k+1,e-1)
+                    if not _le(cons, vp, p[k], (z, c)):
+                        return False
+                if k >= 0 and not _le(cons, vp, p[k - 1], p[k]):
+                    return False
+            for s in range(0, top + 1):
+                q = qidx[s]
+                low = sum(min(n[j] * vp.lo[q + j], n[j] * vp.hi[q + j]) for j in range(3))
+                big = need - low
+                if big <= 0:
+                    continue
+                # n . q_s >= need - big (1 - p_s + p_(s-1))
+                coefs = _dot(q, n)
+                const = need - big
+                for (var, c), sign in ((p[s], big), (p[s - 1], -big)):
+                    if var is None:
+                        const += sign * c
+                    else:
+                        coefs.append((var, -sign))
+                cons.add(coefs, const, np.inf)
+        return True
 
     def _feed_rows(self, k0, k1, win, qidx, zval, vp, cons):
         ea, h, lim = self.ea, self.h, self.lim
@@ -746,6 +840,99 @@ class SectionModel:
                 cons.add(coefs, -np.inf, f * h + SLACK)
             if not wv:
                 break  # an unconditional row at this level: higher levels add nothing
+
+
+@dataclass
+class SolverAnswer:
+    """What a MILP solver says, in the terms the floor needs. A solve that stopped on its time
+    limit without a solution is neither infeasible nor found: it proves nothing."""
+    infeasible: bool
+    found: bool               # a solution (feasibility: the horizon is not proved)
+    optimal: bool
+    objective: float          # of the best solution found
+    dual_bound: float         # None when the solver gives none
+    gap: float
+    cpu_s: float
+    x: np.ndarray = None      # the solution, where the solver hands it back
+
+
+def run_highs(cost, vp, A, cons, time_limit_s, verbose, presolve):
+    cpu0 = time.process_time()
+    res = milp(cost, integrality=np.array(vp.integer, float),
+               bounds=Bounds(np.array(vp.lo), np.array(vp.hi)),
+               constraints=LinearConstraint(A, np.array(cons.lo), np.array(cons.hi)),
+               options={"time_limit": time_limit_s, "mip_rel_gap": 0.0, "disp": verbose,
+                        "presolve": presolve})
+    cpu_s = time.process_time() - cpu0
+    if res.status == 2:
+        return SolverAnswer(True, False, False, math.nan, None, math.nan, cpu_s)
+    if res.status not in (0, 1):
+        raise RuntimeError(f"HiGHS: {res.message}")
+    found = res.x is not None
+    return SolverAnswer(False, found, res.status == 0, float(cost @ res.x) if found else math.nan,
+                        res.mip_dual_bound,
+                        res.mip_gap if res.mip_gap is not None else math.nan, cpu_s, res.x)
+
+
+CBC_BINARY = "cbc"
+
+
+def run_cbc(cost, vp, A, cons, time_limit_s, verbose, presolve):
+    """COIN-OR CBC on the MILP written as free MPS (`cbc FILE sec T solve`), its verdict read
+    from its 'Result - ' line. CBC's own preprocessing stays on, as in the cross-checks the
+    docs quote; presolve (HiGHS's) is ignored."""
+    if shutil.which(CBC_BINARY) is None:
+        raise RuntimeError("--solver cbc needs the cbc binary (Debian: apt-get install "
+                           "coinor-cbc; bench/floor/run.sh installs it)")
+    with tempfile.TemporaryDirectory(prefix="floor_cbc_") as tmp:
+        path = os.path.join(tmp, "floor.mps")
+        write_mps(path, cost, vp, A, cons)
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        run = subprocess.run([CBC_BINARY, path, "sec", repr(float(time_limit_s)), "solve",
+                              "quit"], capture_output=True, text=True)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu_s = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    if verbose:
+        print(run.stdout, end="")
+    return parse_cbc(run.stdout, run.returncode, cpu_s)
+
+
+def parse_cbc(text, returncode, cpu_s):
+    """CBC's verdict from its log: 'Result - Problem proven infeasible' (also 'Linear
+    relaxation infeasible'), 'Result - Optimal solution found', 'Result - Stopped on time
+    limit' (with or without a solution: 'Objective value:' is printed only with one); when
+    its first LP is infeasible it prints only 'Problem is infeasible - T seconds'."""
+    lines = text.splitlines()
+    result = next((ln.split("Result - ", 1)[1].strip() for ln in lines
+                   if ln.startswith("Result - ")), None)
+    if result is None and any(ln.startswith("Problem is infeasible") for ln in lines):
+        result = "Problem proven infeasible"
+    if result is None:
+        tail = "\n".join(text.splitlines()[-5:])
+        raise RuntimeError(f"cbc gave no result (exit {returncode}):\n{tail}")
+
+    def number(label):
+        for ln in text.splitlines():
+            if ln.strip().startswith(label):
+                try:
+                    return float(ln.split(":", 1)[1].split()[0])
+                except (IndexError, ValueError):
+                    return None
+        return None
+
+    low = result.lower()
+    if "infeasible" in low:
+        return SolverAnswer(True, False, False, math.nan, None, math.nan, cpu_s)
+    objective = number("Objective value")
+    found = objective is not None and "no feasible" not in low
+    if low.startswith("optimal solution found"):
+        return SolverAnswer(False, True, True, objective, objective, 0.0, cpu_s)
+    if low.startswith("stopped"):
+        bound = number("Lower bound")
+        gap = number("Gap")
+        return SolverAnswer(False, found, False, objective if found else math.nan, bound,
+                            math.nan if gap is None else gap, cpu_s)
+    raise RuntimeError(f"cbc: unexpected result '{result}'")
 
 
 class _VarPool:
@@ -829,6 +1016,22 @@ def write_mps(path, cost, vp, A, cons):
         f.write("ENDATA\n")
 
 
+def _le(cons, vp, x, y):
+    """Row x <= y for (var or None, constant) pairs; False if both are constants and x > y."""
+    (xv, xc), (yv, yc) = x, y
+    if xv is None and yv is None:
+        return xc <= yc
+    if xv is None:
+        if xc > 0.0:
+            vp.lo[yv] = max(vp.lo[yv], xc)
+        return True
+    if yv is None:
+        vp.hi[xv] = min(vp.hi[xv], yc)
+        return True
+    cons.add([(xv, 1.0), (yv, -1.0)], -np.inf, 0.0)
+    return True
+
+
 def _dot(first_var, n):
     return [(first_var + j, float(n[j])) for j in range(3) if n[j] != 0.0]
 
@@ -837,39 +1040,40 @@ def _dot(first_var, n):
 
 def section_floor(moves, a, b, v_mm_s=100.0, a_mm_s2=1000.0, step_ms=1.0, lead_in=25,
                   lead_out=25, horizon_s=None, time_limit_s=120.0, perp_count=8,
-                  verbose=False, group_turn_deg=0.0, search=True, log=None, presolve=False):
+                  verbose=False, group_turn_deg=0.0, search=True, log=None, presolve=False,
+                  reach_vertices=False, solver="highs"):
     """The floor on t_b - t_a for moves (programmed moves; vertex a is the end of move a,
     moves numbered from 1). search=True: bisection on the horizon with feasibility MILPs
     (each infeasible one proves t_b - t_a >= U h); search=False: one MILP minimising the
-    section's sample count within horizon_s."""
-    if horizon_s is None:
-        horizon_s = make_model(moves, a, b, v_mm_s, a_mm_s2, step_ms, lead_in, lead_out, None,
-                               perp_count, group_turn_deg).U * step_ms * 1e-3
+    section's sample count within horizon_s. solver: "highs" (SciPy) or "cbc" (run_cbc)."""
     h = step_ms * 1e-3
 
     def model(hz):
-        return make_model(moves, a, b, v_mm_s, a_mm_s2, step_ms, lead_in, lead_out, hz,
-                          perp_count, group_turn_deg)
+        m = make_model(moves, a, b, v_mm_s, a_mm_s2, step_ms, lead_in, lead_out, hz,
+                       perp_count, group_turn_deg, reach_vertices)
+        m.presolve, m.solver = presolve, solver
+        return m
+
+    if horizon_s is None:
+        horizon_s = model(None).U * h
 
     if not search:
-        m = model(horizon_s)
-        m.presolve = presolve
-        return m.solve(time_limit_s, verbose)
+        return model(horizon_s).solve(time_limit_s, verbose)
     top = model(horizon_s)
     # The corner regions' gaps alone: t_b - t_a >= min_time(a, b).
     lo = int(math.floor(top.min_time(a, b) / h + 1e-9))
     hi = top.U
-    total_s, steps, relaxed = 0.0, [], math.nan
+    total_s, total_cpu_s, steps, relaxed = 0.0, 0.0, [], math.nan
 
     def attempt(u):
-        nonlocal total_s
-        m = model(u * h)
-        m.presolve = presolve
-        res = m.solve(time_limit_s, verbose, feasibility=True)
+        nonlocal total_s, total_cpu_s
+        res = model(u * h).solve(time_limit_s, verbose, feasibility=True)
         total_s += res.solve_s
+        total_cpu_s += res.cpu_s
         steps.append((u, res.status, res.solve_s))
         if log:
-            log(f"  horizon {u * h * 1e3:.0f} ms: {steps[-1][1]} ({res.solve_s:.1f} s)")
+            log(f"  horizon {u * h * 1e3:.0f} ms: {steps[-1][1]} ({res.solve_s:.1f} s, "
+                f"{solver} CPU {res.cpu_s:.1f} s)")
         return res
 
     # The top horizon first: while even it is infeasible, the floor is at least that, and a
@@ -883,7 +1087,7 @@ def section_floor(moves, a, b, v_mm_s=100.0, a_mm_s2=1000.0, step_ms=1.0, lead_i
         lo, hi = hi, int(math.ceil(hi * 1.5))
     else:
         return FloorResult(lo * h, "infeasible up to the last horizon tried", lo, relaxed,
-                           math.nan, total_s, h, lo * h, 0, 0, 0, steps)
+                           math.nan, total_s, h, lo * h, 0, 0, 0, steps, total_cpu_s)
     while hi - lo > 1:
         u = (lo + hi) // 2
         res = attempt(u)
@@ -893,11 +1097,12 @@ def section_floor(moves, a, b, v_mm_s=100.0, a_mm_s2=1000.0, step_ms=1.0, lead_i
             if res.status == "feasible":
                 relaxed = min(relaxed, res.relaxed_s) if relaxed == relaxed else res.relaxed_s
             hi = u
-    status = "bisection" + ("" if presolve else " without presolve")
+    status = f"bisection, {solver}" + ("" if presolve or solver != "highs" else
+                                       " without presolve")
     if any(st.startswith("unknown") for _, st, _ in steps):
         status += " (solves that hit the time limit count as not proved)"
     return FloorResult(lo * h, status, lo, relaxed, math.nan, total_s, h, hi * h, 0, 0, 0,
-                       steps)
+                       steps, total_cpu_s)
 
 
 def default_horizon_s(mv, a, b, lim):
@@ -935,6 +1140,10 @@ def main():
     ap.add_argument("--group-deg", type=float, default=0.0,
                     help="take chains of lines turning less than this from their chord as one "
                     "element, the hull of their tubes (default 0: every move on its own)")
+    ap.add_argument("--reach-vertices", action="store_true",
+                    help="the stricter contract: while a line or rapid is the current move, the "
+                    "tool gets within P of both its end points along it (a plunge reaches its "
+                    "depth); its floors hold only for motions that keep this too")
     ap.add_argument("--single", action="store_true",
                     help="one MILP minimising the count within the horizon (its dual bound is "
                     "the floor) instead of the bisection on the horizon")
@@ -947,8 +1156,12 @@ def main():
     ap.add_argument("--presolve", action="store_true",
                     help="use HiGHS's presolve (faster, but HiGHS 1.2's once declared a real "
                     "motion infeasible: not for proofs)")
-    ap.add_argument("--time-limit", type=float, default=300.0, help="HiGHS time limit, s")
-    ap.add_argument("--verbose", action="store_true", help="HiGHS's log")
+    ap.add_argument("--solver", choices=("highs", "cbc"), default="highs",
+                    help="HiGHS through SciPy (default) or COIN-OR CBC (the cbc binary, "
+                    "coinor-cbc, on the MILP written as MPS)")
+    ap.add_argument("--time-limit", type=float, default=300.0,
+                    help="each solve's time limit, s (cbc counts CPU seconds)")
+    ap.add_argument("--verbose", action="store_true", help="the solver's log")
     ap.add_argument("--trajectory", help="write the relaxed trajectory (k x y z) here")
     args = ap.parse_args()
     try:
@@ -958,10 +1171,12 @@ def main():
     try:
         moves = parse_program(args.program, args.tolerance)
         a, b = section_vertices(moves, first, last)
+        contract = " (--reach-vertices contract)" if args.reach_vertices else ""
         if args.prove_ms is not None:
             model = make_model(moves, a, b, args.vmax, args.amax, args.step_ms, args.lead_in,
-                               args.lead_out, args.prove_ms * 1e-3, args.perp, args.group_deg)
-            model.presolve = args.presolve
+                               args.lead_out, args.prove_ms * 1e-3, args.perp, args.group_deg,
+                               args.reach_vertices)
+            model.presolve, model.solver = args.presolve, args.solver
             if args.export_mps:
                 model.solve(feasibility=True, mps_path=args.export_mps)
                 print(f"lines {first}-{last}, horizon {model.U * model.h * 1e3:.0f} ms: "
@@ -971,31 +1186,36 @@ def main():
             verdict = {"infeasible in horizon": f"proved: t_b - t_a >= {model.U * model.h:.3f} s",
                        "feasible": "not proved: the relaxation has a motion this fast",
                        "unknown": "not proved: time limit"}[res.status]
-            print(f"lines {first}-{last}, horizon {model.U * model.h * 1e3:.0f} ms: {verdict} "
-                  f"({res.solve_s:.1f} s)")
+            print(f"lines {first}-{last}{contract}, horizon {model.U * model.h * 1e3:.0f} ms: "
+                  f"{verdict} ({res.solve_s:.1f} s; {args.solver} CPU {res.cpu_s:.1f} s)")
             return
         res = section_floor(moves, a, b, args.vmax, args.amax, args.step_ms, args.lead_in,
                             args.lead_out, None if args.horizon_ms is None else
                             args.horizon_ms * 1e-3, args.time_limit, args.perp, args.verbose,
                             args.group_deg, not args.single, log=print,
-                            presolve=args.presolve)
+                            presolve=args.presolve, reach_vertices=args.reach_vertices,
+                            solver=args.solver)
     except ProgramError as e:
         sys.exit(str(e))
     if args.single:
-        print(f"lines {first}-{last}: floor {res.floor_s:.3f} s ({res.status}; N >= "
+        print(f"lines {first}-{last}{contract}: floor {res.floor_s:.3f} s ({res.status}; N >= "
               f"{res.samples_proved} steps of {res.step_s * 1e3:g} ms), best relaxed trajectory "
-              f"{res.relaxed_s:.3f} s, gap {res.gap:.3g}, solve {res.solve_s:.1f} s, horizon "
+              f"{res.relaxed_s:.3f} s, gap {res.gap:.3g}, solve {res.solve_s:.1f} s "
+              f"({args.solver} CPU {res.cpu_s:.1f} s), horizon "
               f"{res.horizon_s:.3f} s, {res.variables} variables ({res.binaries} binary), "
               f"{res.rows} rows")
         if res.samples_proved >= round(res.horizon_s / res.step_s) - 1:
             print("note: the floor reached the horizon's end; raise --horizon-ms")
     else:
+        feasible = [u for u, st, _ in res.trajectory if st == "feasible"]
         found = (f"the fastest relaxed motion found takes {res.relaxed_s:.3f} s"
-                 if res.relaxed_s == res.relaxed_s else "no relaxed motion found")
-        print(f"lines {first}-{last}: floor {res.floor_s:.3f} s ({res.status}; N >= "
+                 if res.relaxed_s == res.relaxed_s else
+                 f"feasible at {min(feasible) * res.step_s * 1e3:.0f} ms" if feasible else
+                 "no relaxed motion found")
+        print(f"lines {first}-{last}{contract}: floor {res.floor_s:.3f} s ({res.status}; N >= "
               f"{res.samples_proved} steps of {res.step_s * 1e3:g} ms; {found}), solves "
-              f"{res.solve_s:.1f} s")
-    if args.trajectory and res.trajectory:
+              f"{res.solve_s:.1f} s ({args.solver} CPU {res.cpu_s:.1f} s)")
+    if args.trajectory and args.single and res.trajectory:
         with open(args.trajectory, "w") as f:
             for k, q in res.trajectory:
                 f.write(f"{k} {q[0]:.6f} {q[1]:.6f} {q[2]:.6f}\n")

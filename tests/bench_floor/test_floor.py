@@ -7,6 +7,7 @@ our planner's trace (a real motion that keeps the contract) and require it to be
 """
 import math
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -44,7 +45,7 @@ def floor_of(text, first, last, step_ms, **kw):
         os.unlink(path)
 
 
-def model_of(text, first, last, step_ms, horizon_s, lead=25, group_deg=0.0):
+def model_of(text, first, last, step_ms, horizon_s, lead=25, group_deg=0.0, reach=False):
     path = write_program(text)
     try:
         moves = floor.parse_program(path)
@@ -52,7 +53,11 @@ def model_of(text, first, last, step_ms, horizon_s, lead=25, group_deg=0.0):
         os.unlink(path)
     a, b = floor.section_vertices(moves, first, last)
     return floor.make_model(moves, a, b, V, A, step_ms, lead, lead, horizon_s,
-                            group_turn_deg=group_deg), moves
+                            group_turn_deg=group_deg, reach_vertices=reach), moves
+
+
+# tp_default's opening: a hop up and back down to where the row starts.
+HOP = "G21 G90\nG0 Z1\nG1 Z0 F600\nG1 X1 F3000\nM2\n"
 
 
 class TestFloor(unittest.TestCase):
@@ -101,7 +106,29 @@ class TestFloor(unittest.TestCase):
         res = model.solve(time_limit_s=60, feasibility=True)
         self.assertEqual(res.status, "infeasible in horizon", f"horizon {u * h:.3f} s")
 
-    def _trace_is_feasible(self, text, group_deg=0.0, free_assignment=False):
+    def test_hop_is_free_under_the_path_contract_but_not_when_vertices_are_reached(self):
+        # HOP from rest at the origin, section lines 2-3 (G0 Z1, G1 Z0 F600) ending at the
+        # origin, where the X line starts. The path-distance contract lets the tool stay at the
+        # origin (the hop retraces itself): a 12 ms horizon is feasible. Reaching vertices:
+        # while G1 Z0 is the current move the tool is within P of its start along it, z >= 0.99
+        # at some instant tau' >= t_2; at t_3 it is in the corner region with the X line, so
+        # z <= P = 0.01; in between it is on the F600 move, at most 10 mm/s: t_3 - tau' >=
+        # 0.98 / 10 = 98 ms. Before tau' it climbed from rest at z = 0 to 0.99 with |z''| <= A:
+        # tau' >= sqrt(2 * 0.99 / A) = 44.50 ms. So t_3 - t_a >= 142.50 ms. At h = 4 ms (2 ms
+        # costs HiGHS ten times the CPU) the grid may lose 2h and a little at the turn: 132 ms
+        # must already be infeasible.
+        h = 4e-3
+        model, _ = model_of(HOP, 2, 3, 4.0, 3 * h, lead=10)
+        self.assertEqual(model.solve(time_limit_s=60, feasibility=True).status, "feasible")
+        hand = math.sqrt(2 * (1 - P) / A) + (1 - 2 * P) / 10.0
+        self.assertAlmostEqual(hand, 0.14250, places=5)
+        u = int(math.floor((hand - 2 * h - 1e-3) / h))
+        self.assertEqual(u, 33)
+        model, _ = model_of(HOP, 2, 3, 4.0, u * h, lead=10, reach=True)
+        res = model.solve(time_limit_s=60, feasibility=True)
+        self.assertEqual(res.status, "infeasible in horizon", f"horizon {u * h:.3f} s")
+
+    def _trace_is_feasible(self, text, group_deg=0.0, free_assignment=False, reach=False):
         """Our planner's trace of text (a real motion within P) pinned as the samples of the
         whole program's section must satisfy every row of the MILP: the kinematic rows, the
         tubes (or chain hulls), the feed rows and the windows of elements each sample may be
@@ -123,7 +150,10 @@ class TestFloor(unittest.TestCase):
         # end from the last sample on, so t_b <= len(trace) ms and N <= len(trace).
         lead = 10
         model = floor.make_model(moves, 0, len(moves), V, A, 1.0, lead, lead,
-                                 (len(trace) + 1) * 1e-3, group_turn_deg=group_deg)
+                                 (len(trace) + 1) * 1e-3, group_turn_deg=group_deg,
+                                 reach_vertices=reach)
+        if reach:  # the test is about those rows: the program must have some
+            self.assertTrue(model.reach_clauses())
         fixed = {k: moves[0].start for k in range(-lead, 1)}
         for k, q in enumerate(trace, 1):
             fixed[k] = q
@@ -168,6 +198,33 @@ class TestFloor(unittest.TestCase):
         # A half circle (its hull rows and the arc's feed, 40 mm/s) between two lines, as
         # before tp_default's line 831.
         self._trace_is_feasible("G21 G90\nG1 X2 F2400\nG3 X7 Y0 I2.5 J0\nG1 Y4 F4000\nM2\n")
+
+    def test_planner_trace_satisfies_the_reach_vertices_rows(self):
+        # tp_default's opening (the hop, the zero-length G1 and a row step), then a right
+        # angle: our planner reaches Z1 and turns the hop where it is programmed, and its
+        # offset corner passes the right angle 0.99 P from each line, within P of the vertex
+        # along both moves. HiGHS chooses the assignment (the earliest one would keep the
+        # whole hop on the G0).
+        prog = ("G21 G90 G17\nG0 X0 Y0 Z1\nG1 Z0 F600\nG1 X0 Y0 Z0 F3000\n"
+                "G1 X0.5 Y0.0998 Z-0.0006\nG1 Y1\nM2\n")
+        self._trace_is_feasible(prog, free_assignment=True, reach=True)
+
+    @unittest.skipUnless(shutil.which("cbc"), "cbc (coinor-cbc) is not installed")
+    def test_cbc_agrees_with_highs(self):
+        # G1 X10 F1800 at h = 2 ms (worked out in line_at_feed_is_length_over_feed_plus_ramps:
+        # N >= 180 exactly): 360 ms infeasible, 362 ms feasible; the hop with reached vertices
+        # at h = 4 ms: 132 ms infeasible (worked out above). Both solvers must say the same.
+        line = "G21 G90\nG1 X10 F1800\nM2\n"
+        cases = [(line, 2, 2, 2.0, 25, 0.360, False, "infeasible in horizon"),
+                 (line, 2, 2, 2.0, 25, 0.362, False, "feasible"),
+                 (HOP, 2, 3, 4.0, 10, 0.132, True, "infeasible in horizon")]
+        for text, first, last, step_ms, lead, horizon_s, reach, want in cases:
+            for solver in ("highs", "cbc"):
+                model, _ = model_of(text, first, last, step_ms, horizon_s, lead=lead,
+                                    reach=reach)
+                model.solver = solver
+                res = model.solve(time_limit_s=60, feasibility=True)
+                self.assertEqual(res.status, want, f"{solver}, horizon {horizon_s} s")
 
     def test_floor_is_below_the_planner_on_a_short_u_turn(self):
         # The bisection itself: its floor may not exceed the time of a real motion.
