@@ -41,7 +41,8 @@ constexpr int kBlendAttempts = 12;
 // the margin leaves the blend over half its acceleration for speed changes at that speed
 // (surface_3d: 9.74 s at 1.05, 9.64 s at 1.5). Between a rapid and a feed move (or two feeds)
 // the blend runs at the slower feed, so it is cut as short as will do (ex08: 84.110 s at 1.05,
-// 84.128 s at 1.5).
+// 84.128 s at 1.5): with an arc for this margin (a Bezier turns a little harder than the
+// parabola), between two lines for exactly that feed (classify).
 constexpr double kCornerSpeedMargin = 1.5;
 constexpr double kMixedCornerSpeedMargin = 1.05;
 constexpr double kSpeedCutFloor = 1.0 / 16;
@@ -232,17 +233,24 @@ void Planner::classify(const Piece& p, const Piece& next, Junction& jn) const {
     // takes length from the moves, which speed up and slow down faster than a blend (and, when
     // one of them is a rapid, at the rapid's speed): cut only what passing at the speed either
     // move allows there (with a margin) needs. The parabola's cap is the model; the Bezier blends
-    // with an arc turn a little harder, hence the margin.
-    double l_speed_mm = kInf, speed_margin = 1;
+    // with an arc turn a little harder, hence the margin. Between two lines of different feeds
+    // the turn runs at the slower one whatever its cut, so it is cut for exactly that speed on
+    // the share of the acceleration an offset corner's turn or an isolated parabola gets
+    // (kIsolatedBlendCentripetal): 1.05 x on the default share made a 90 degree turn at
+    // 10 mm/s 15 % longer (tp_default's G0 Y30 -> G1 Z0 F600). A parabola that will not be
+    // isolated is cut for its own share below.
+    const bool lines = p.geom.kind == ElementKind::Line && next.geom.kind == ElementKind::Line;
+    const bool mixed = p.feed_mm_s != next.feed_mm_s;
+    double l_speed_mm = kInf, speed_margin = 1, pass_mm_s = kInf;
     if (!jerk_mode_) {
-        double pass_mm_s = pass_speed_cap(pe.tangent, ns.tangent, lim,
-                                          std::min(p.feed_mm_s > 0 ? p.feed_mm_s : kInf,
-                                                   next.feed_mm_s > 0 ? next.feed_mm_s : kInf));
-        speed_margin = p.feed_mm_s == next.feed_mm_s ? kCornerSpeedMargin : kMixedCornerSpeedMargin;
-        l_speed_mm = parabola_cut_for_speed_mm(dt, speed_margin * pass_mm_s, lim,
-                                               {1 - reserve_, 1 - reserve_});
+        pass_mm_s = pass_speed_cap(pe.tangent, ns.tangent, lim,
+                                   std::min(p.feed_mm_s > 0 ? p.feed_mm_s : kInf,
+                                            next.feed_mm_s > 0 ? next.feed_mm_s : kInf));
+        speed_margin = !mixed ? kCornerSpeedMargin : lines ? 1.0 : kMixedCornerSpeedMargin;
+        l_speed_mm = parabola_cut_for_speed_mm(
+            dt, speed_margin * pass_mm_s, lim,
+            {1 - reserve_, 1 - reserve_, mixed && lines ? kIsolatedBlendCentripetal : 0.0});
     }
-    bool lines = p.geom.kind == ElementKind::Line && next.geom.kind == ElementKind::Line;
     if (lines && p.tolerance_mm > 0) {
         double l = std::min(p.geom.length_mm, next.geom.length_mm) / 2;
         // A (near) reversal stops at its end point: the axis passes through zero speed there
@@ -260,6 +268,13 @@ void Planner::classify(const Piece& p, const Piece& next, Junction& jn) const {
                 offset_corners(p, next, sin_angle, l_speed_mm, jn))
                 return;
             l = cut_for_speed(l_geom, l_speed_mm);
+            // close_piece gives a parabola kIsolatedBlendCentripetal only when both moves keep
+            // at least its cut beside it; otherwise it turns on the default share.
+            const bool isolated = p.geom.length_mm - p.trim_start_mm - l >= l &&
+                                  next.geom.length_mm / 2 >= 2 * l;
+            if (mixed && !isolated)
+                l = cut_for_speed(l_geom, parabola_cut_for_speed_mm(
+                                              dt, pass_mm_s, lim, {1 - reserve_, 1 - reserve_}));
             if (l > kMinLength_mm) return jn.set(kInf, false, l, Blend::Parabola);
         } else {
             l = std::min(l, p.tolerance_mm / (kBlendDeviationPerL * sin_angle));

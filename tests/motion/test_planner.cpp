@@ -270,11 +270,12 @@ TEST(Planner, RightAngleOntoAShortLineIsCutOnTheLongLineMovedOutwards) {
     EXPECT_NEAR(end.pos_mm[1], lp - d, 1e-12);
 }
 
-// A rapid into a slow feed move: the blend runs at the feed (4 mm/s), so it is cut only as long
-// as passing at 1.05 times the feed needs, l = (1.05 * 4)^2 |dT_x| / (2 * 0.95 * 990) =
-// 0.009378 mm (|dT_x| = 1 at 90 degrees) instead of the tolerance's 0.04 mm, and the rapid
-// keeps the rest at its own speed. The blend is isolated (0.99): its cap sqrt(0.99 * 990 * 2l)
-// = 4.29 mm/s is above the feed.
+// A rapid into a slow feed move: the blend runs at the feed (4 mm/s) whatever its cut, so it is
+// cut only as long as passing at exactly the feed needs on the share an isolated blend turns
+// with, l = 4^2 |dT_x| / (2 * 0.99 * 990) = 0.008163 mm (|dT_x| = 1 at 90 degrees) instead of
+// the tolerance's 0.04 mm, and the rapid keeps the rest at its own speed. The blend is isolated
+// (0.99): its cap sqrt(0.99 * 990 * 2l) is the feed itself. (Until 2026-11-22 the cut was for
+// 1.05 x the feed on 0.95: 0.009378 mm, a turn 15 % longer than needed.)
 TEST(Planner, RapidIntoSlowFeedIsBlendedOnlyAsFarAsTheFeedNeeds) {
     PlannerConfig cfg = uniform(100, 1000, 0);
     PathSegment rapid = line_to({10}, 0, 0.01, 0);
@@ -282,7 +283,7 @@ TEST(Planner, RapidIntoSlowFeedIsBlendedOnlyAsFarAsTheFeedNeeds) {
     auto recs = plan(cfg, {rapid, line_to({10, 10}, 4, 0.01, 1)});
     ASSERT_EQ(recs.size(), 3u);
     ASSERT_EQ(recs[1].geom.kind, ElementKind::Bezier);
-    double l = 4.2 * 4.2 / (2 * 0.95 * 990);
+    double l = 4.0 * 4.0 / (2 * 0.99 * 990);
     EXPECT_NEAR(recs[1].geom.length_mm, 2 * l, 1e-12);
     EXPECT_NEAR(recs[0].geom.length_mm, 10 - l, 1e-12);
     EXPECT_NEAR(recs[1].profile.peak_v_mm_s, 4, 1e-9);
