@@ -255,6 +255,15 @@ def _pick(els, cum, indices, q, s_last):
     return dmin, s, i
 
 
+def _lines_near(els, cum, s):
+    """The program lines a sample at path position s may be tagged with: those of the elements
+    within BACK_MM behind and AHEAD_MM ahead (and the lines between them that do not move: modes,
+    dwells, the end), so a line number from elsewhere in the program fails."""
+    lo = max(0, bisect.bisect_left(cum, s - BACK_MM) - 1)
+    hi = min(len(els) - 1, bisect.bisect_right(cum, s + AHEAD_MM))
+    return (els[lo].line if lo > 0 else 0, els[hi].line if hi < len(els) - 1 else math.inf)
+
+
 def check_path(tr, model):
     els = model.elements
     if not els:
@@ -274,6 +283,11 @@ def check_path(tr, model):
         if d > _allowed(els, i, axes):
             return Failure("path", f"{d:.6f} mm from the programmed path (tolerance {_tolerance(els, i)} mm) "
                                    f"near program line {els[i].line}", tr.line[n], tr.t[n])
+        lines = _lines_near(els, cum, s)
+        if not lines[0] <= tr.line[n] <= lines[1]:
+            return Failure("line-tag", f"the trace says line {tr.line[n]} where the tool is on the path of "
+                                       f"line {els[i].line} (lines {lines[0]}..{lines[1]} lie within "
+                                       f"{BACK_MM} mm behind, {AHEAD_MM} mm ahead)", tr.line[n], tr.t[n])
     last = els[-1]
     if math.dist(tr.axes[-1], last.end) > 1e-4:
         return Failure("path", f"the trace ends at {tr.axes[-1]}, not at the program's last point {last.end}",

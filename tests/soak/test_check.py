@@ -46,39 +46,50 @@ class PathCheck(unittest.TestCase):
         # Exact path (G61): the corner at (10, 0) is stopped at, tolerance 0 everywhere.
         self.model = model_of(["G61 F600", "G1 X10", "G1 Y10", "M30"], self.m)
         self.pts = smooth_move([0, 0, 0], [10, 0, 0], 1.0) + smooth_move([10, 0, 0], [10, 10, 0], 1.0)
+        self.lines = [2] * 1005 + [3] * 1005
 
     def test_on_the_path_passes(self):
-        self.assertIsNone(check.check_path(trace_of(self.pts), self.model))
+        self.assertIsNone(check.check_path(trace_of(self.pts, self.lines), self.model))
 
     def test_a_sample_moved_off_the_path_fails(self):
         pts = [list(p) for p in self.pts]
         pts[500][1] += 0.05
-        f = check.check_path(trace_of(pts), self.model)
+        f = check.check_path(trace_of(pts, self.lines), self.model)
         self.assertIsNotNone(f)
         self.assertEqual(f.check, "path")
         self.assertAlmostEqual(f.trace_t_s, 0.501)
         # On an exact path only the rounding of the printed numbers is allowed: sqrt(3) * 0.5e-6 mm.
         pts[500][1] = self.pts[500][1] + 0.8e-6
-        self.assertIsNone(check.check_path(trace_of(pts), self.model))
+        self.assertIsNone(check.check_path(trace_of(pts, self.lines), self.model))
         pts[500][1] = self.pts[500][1] + 1.2e-6
-        self.assertIsNotNone(check.check_path(trace_of(pts), self.model))
+        self.assertIsNotNone(check.check_path(trace_of(pts, self.lines), self.model))
 
     def test_within_the_blend_tolerance_passes(self):
         model = model_of(["G64 P0.05 F600", "G1 X10", "G1 Y10", "M30"], self.m)
         pts = [list(p) for p in self.pts]
         pts[500][1] += 0.049  # the tolerance of the corner at its end applies along the move
-        self.assertIsNone(check.check_path(trace_of(pts), model))
+        self.assertIsNone(check.check_path(trace_of(pts, self.lines), model))
         pts[500][1] += 0.002
-        self.assertIsNotNone(check.check_path(trace_of(pts), model))
+        self.assertIsNotNone(check.check_path(trace_of(pts, self.lines), model))
 
     def test_running_the_path_backwards_fails(self):
         f = check.check_path(trace_of(list(reversed(self.pts))), self.model)
         self.assertIsNotNone(f)
 
     def test_stopping_short_fails(self):
-        f = check.check_path(trace_of(self.pts[:-600]), self.model)
+        f = check.check_path(trace_of(self.pts[:-600], self.lines[:-600]), self.model)
         self.assertIsNotNone(f)
         self.assertIn("ends at", f.detail)
+
+    def test_a_wrong_line_tag_fails(self):
+        model = model_of(["G61 F600", "G1 X10", "G1 Y10", "G1 X0", "M30"], self.m)
+        pts = self.pts + smooth_move([10, 10, 0], [0, 10, 0], 1.0)
+        lines = [2] * 1005 + [3] * 1005 + [4] * 1005
+        self.assertIsNone(check.check_path(trace_of(pts, lines), model))
+        lines[200] = 4  # 1 mm along line 2, the tag of line 4 (10 mm of path ahead)
+        f = check.check_path(trace_of(pts, lines), model)
+        self.assertIsNotNone(f)
+        self.assertEqual(f.check, "line-tag")
 
     def test_arc_and_helix_distances(self):
         model = model_of(["F600", "G0 X20 Y10", "G3 X10 Y20 Z-3 I-10 J0", "M30"], self.m)
