@@ -188,7 +188,7 @@ def _arc_points(e, q):
     """[(distance, fraction)] of the nearest points of an arc or helix, one per turn the sweep
     covers at the sample's angle about the centre (a full circle has its start twice), refined
     by Newton steps on the squared distance (exact for plane arcs), and both ends."""
-    u, v, cu, cv, r, th0, sweep = e.arc
+    u, v, cu, cv, r, th0, sweep, _ = e.arc
     span = abs(sweep)
     sgn = 1 if sweep >= 0 else -1
     rho = math.hypot(q[u] - cu, q[v] - cv)
@@ -239,20 +239,30 @@ def _tolerance(els, i):
 
 
 def _allowed(els, i, axes):
-    return _tolerance(els, i) * (1 + REL) + math.sqrt(axes) * QUANTUM / 2 + 1e-9
+    return _tolerance(els, i) * (1 + REL) + els[i].extra_mm + math.sqrt(axes) * QUANTUM / 2 + 1e-9
 
 
-def _pick(els, cum, indices, q, s_last):
-    """(distance, path position s, element) of the nearest point, ties going to the point that
-    continues from s_last (the distance is the smallest either way)."""
+def _pick(els, cum, indices, q, s_last, s_max, axes):
+    """(excess, distance, path position s, element) of the point of the path within the window
+    about s_max that the sample is nearest to relative to its allowance (excess = distance -
+    allowed there: a sample near two elements needs to be within the tolerance of one of them).
+    A nearest point outside the window is replaced by the window's end on that element. Ties go
+    to the point that continues from s_last."""
     cands = []
+    lo, hi = s_max - BACK_MM, s_max + AHEAD_MM
     for i in indices:
-        for d, f in nearest_points(els[i], q):
-            cands.append((d, cum[i] + f * els[i].length_mm, i))
-    dmin = min(c[0] for c in cands)
-    near = [c for c in cands if c[0] <= dmin + QUANTUM]
-    _, s, i = min(near, key=lambda c: (c[1] < s_last - 1e-9, abs(c[1] - s_last)))
-    return dmin, s, i
+        e = els[i]
+        allowed = _allowed(els, i, axes)
+        for d, f in nearest_points(e, q):
+            s = cum[i] + f * e.length_mm
+            if not lo <= s <= hi:
+                s = min(hi, max(lo, s))
+                d = math.dist(q, e.point(min(1.0, max(0.0, (s - cum[i]) / e.length_mm))))
+            cands.append((d - allowed, d, s, i))
+    best = min(cands)
+    near = [c for c in cands if c[0] <= best[0] + QUANTUM]
+    _, _, s, i = min(near, key=lambda c: (c[2] < s_last - 1e-9, abs(c[2] - s_last)))
+    return best[0], best[1], s, i, best[3]
 
 
 def _lines_near(els, cum, s):
@@ -274,13 +284,15 @@ def check_path(tr, model):
     cur, s_last, s_max = 0, 0.0, 0.0
     axes = len(els[0].start)
     for n, q in enumerate(tr.axes):
-        d, s, i = _pick(els, cum, [k for k in (cur, cur + 1) if k < len(els)], q, s_last)
-        if d > _allowed(els, i, axes):
+        pick = _pick(els, cum, [k for k in (cur, cur + 1) if k < len(els)], q, s_last, s_max, axes)
+        if pick[0] > 0:
             lo = max(0, bisect.bisect_left(cum, s_max - BACK_MM) - 1)
             hi = min(len(els), bisect.bisect_right(cum, s_max + AHEAD_MM) + 1)
-            d, s, i = _pick(els, cum, range(lo, hi), q, s_last)
+            pick = _pick(els, cum, range(lo, hi), q, s_last, s_max, axes)
+        excess, d, s, i, nearest = pick
         cur, s_last, s_max = i, s, max(s_max, s)
-        if d > _allowed(els, i, axes):
+        if excess > 0:
+            i = nearest
             return Failure("path", f"{d:.6f} mm from the programmed path (tolerance {_tolerance(els, i)} mm) "
                                    f"near program line {els[i].line}", tr.line[n], tr.t[n])
         lines = _lines_near(els, cum, s)
@@ -288,6 +300,9 @@ def check_path(tr, model):
             return Failure("line-tag", f"the trace says line {tr.line[n]} where the tool is on the path of "
                                        f"line {els[i].line} (lines {lines[0]}..{lines[1]} lie within "
                                        f"{BACK_MM} mm behind, {AHEAD_MM} mm ahead)", tr.line[n], tr.t[n])
+    if s_max < cum[-1] - AHEAD_MM:
+        return Failure("path", f"the trace covered the path only up to {s_max:.3f} mm of its {cum[-1]:.3f} mm",
+                       tr.line[-1], tr.t[-1])
     last = els[-1]
     if math.dist(tr.axes[-1], last.end) > 1e-4:
         return Failure("path", f"the trace ends at {tr.axes[-1]}, not at the program's last point {last.end}",

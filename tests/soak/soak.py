@@ -101,7 +101,7 @@ def shrink(cnc, machine, lines, failure, workdir, timeout_s, budget_s):
 
 def soak_one(args, config, seed):
     machine = read_machine(os.path.join(ROOT, "configs", "sim", config + ".ini"))
-    lines = generate(machine, seed, args.steps)
+    lines = generate(machine, seed, args.steps, args.arc_end_off)
     work = tempfile.mkdtemp(prefix=f"soak-{config}-{seed}-")
     try:
         t0 = time.monotonic()
@@ -147,6 +147,9 @@ def main():
     ap.add_argument("--no-shrink", action="store_true", help="do not shrink failing programs")
     ap.add_argument("--shrink-s", type=float, default=120, help="wall seconds to spend shrinking one failure")
     ap.add_argument("--run-timeout", type=float, default=300, help="wall seconds one cnc run may take")
+    ap.add_argument("--arc-end-off", type=float, default=0.0,
+                    help="also write I J arcs whose end is off the circle by up to this many mm, many "
+                         "of them nearly full circles (0 = none; docs/soak.md says why it is off)")
     ap.add_argument("--print-program", action="store_true", help="print the programs, run nothing")
     args = ap.parse_args()
     configs = CONFIGS if args.configs == "all" else tuple(args.configs.split(","))
@@ -155,7 +158,7 @@ def main():
         for c in configs:
             m = read_machine(os.path.join(ROOT, "configs", "sim", c + ".ini"))
             for s in seeds:
-                print(f"; {c} seed {s}\n" + "\n".join(generate(m, s, args.steps)))
+                print(f"; {c} seed {s}\n" + "\n".join(generate(m, s, args.steps, args.arc_end_off)))
         return 0
     if not os.access(args.cnc, os.X_OK):
         print(f"soak: {args.cnc}: not an executable (build the cnc target, or pass --cnc)", file=sys.stderr)
