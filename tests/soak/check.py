@@ -185,32 +185,58 @@ def _line_points(e, q):
 
 
 def _arc_points(e, q):
-    """[(distance, fraction)] of the nearest points of an arc or helix, one per turn the sweep
-    covers at the sample's angle about the centre (a full circle has its start twice), refined
-    by Newton steps on the squared distance (exact for plane arcs), and both ends."""
-    u, v, cu, cv, r, th0, sweep, _ = e.arc
+    """[(distance, fraction)] of the nearest points of an arc or helix: both ends, and the
+    minimum of the squared distance over the sweep (a grid of pi/16 steps, refined by a golden
+    section search in the steps about the best). The squared distance from a point to the
+    spiral-helix p(t) = C + r(t) (cos, sin)(theta0 + t) + (t / span) D is, with rho and tq the
+    sample's radius and angle in the plane and W its offset in the other axes from the start,
+    rho^2 + r(t)^2 - 2 r(t) rho cos(t - tq) + |W - (t / span) D|^2."""
+    u, v, cu, cv, r0, th0, sweep, r1 = e.arc
     span = abs(sweep)
     sgn = 1 if sweep >= 0 else -1
     rho = math.hypot(q[u] - cu, q[v] - cv)
-    tq = (sgn * (math.atan2(q[v] - cv, q[u] - cu) - th0)) % (2 * math.pi)
+    tq = sgn * (math.atan2(q[v] - cv, q[u] - cu) - th0)
     others = [k for k in range(len(q)) if k not in (u, v)]
     D = [e.end[k] - e.start[k] for k in others]
     W = [q[k] - e.start[k] for k in others]
-    dd = sum(x * x for x in D)
+
+    def f2(t):
+        g = t / span
+        r = r0 + (r1 - r0) * g
+        lin = 0.0
+        for w, d in zip(W, D):
+            lin += (w - g * d) ** 2
+        return rho * rho + r * r - 2 * r * rho * math.cos(t - tq) + lin
+
+    n = max(8, math.ceil(span / (math.pi / 16)))
+    step = span / n
+    grid = [f2(i * step) for i in range(n + 1)]
     out = [(math.dist(q, e.point(0.0)), 0.0), (math.dist(q, e.point(1.0)), 1.0)]
-    t = tq
-    while t <= span:
-        x = t
-        for _ in range(6 if dd > 0 else 0):
-            lin = [w - x / span * d for w, d in zip(W, D)]
-            g = 2 * r * rho * math.sin(x - tq) - 2 * sum(a * b for a, b in zip(lin, D)) / span
-            h = 2 * r * rho * math.cos(x - tq) + 2 * dd / span ** 2
-            if h <= 0:
-                break
-            x = min(span, max(0.0, x - g / h))
-        out.append((math.dist(q, e.point(x / span)), x / span))
-        t += 2 * math.pi
+    # Every local minimum of the grid is refined: two can tie on the grid while only one holds
+    # the true minimum (a sample just before a full circle's end: the grid points either side of
+    # it are as near as the start).
+    for k in range(n + 1):
+        if (k > 0 and grid[k] > grid[k - 1]) or (k < n and grid[k] > grid[k + 1]):
+            continue
+        t = _golden(f2, max(0.0, (k - 1) * step), min(span, (k + 1) * step))
+        out.append((math.dist(q, e.point(t / span)), t / span))
     return out
+
+
+def _golden(f, lo, hi):
+    g = 0.6180339887498949
+    a, b = hi - g * (hi - lo), lo + g * (hi - lo)
+    fa, fb = f(a), f(b)
+    for _ in range(40):
+        if fa < fb:
+            hi, b, fb = b, a, fa
+            a = hi - g * (hi - lo)
+            fa = f(a)
+        else:
+            lo, a, fa = a, b, fb
+            b = lo + g * (hi - lo)
+            fb = f(b)
+    return (lo + hi) / 2
 
 
 def nearest_points(e, q):

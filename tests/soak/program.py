@@ -191,8 +191,10 @@ class Model:
         # The interpreter accepts an end up to 0.01 mm off the circle (FEATURES ARC-11); the
         # planner refuses more than max(0.005, 0.1 % of the radius). The programmed path is then
         # the arc about the programmed centre whose radius goes from the start's to the end's
-        # (LinuxCNC's spiral); a planner may realise it otherwise (ours moves the centre onto the
-        # chord's bisector), so the check allows the mismatch plus 1 um about it.
+        # (LinuxCNC's spiral). A planner may realise it otherwise: ours moves the centre onto the
+        # chord's bisector, which for the rounding of 4 decimals moves the path by a few
+        # 1e-5 mm, but for an end near the start by much more (docs/soak.md, finding 2). The
+        # check allows that difference, up to 1 um (extra_mm).
         if r0 < 1e-9 or abs(r1 - r0) > max(0.005, 1e-3 * r0):
             raise ProgramError(f"line {self.line_no}: arc end not on the circle ({r0} vs {r1})")
         th0 = math.atan2(sv - cv, su - cu)
@@ -204,7 +206,8 @@ class Model:
         rest = math.sqrt(sum((e - b) ** 2 for k, (b, e) in enumerate(zip(s, end)) if k not in (u, v)))
         self._push(s, end, False, (u, v, cu, cv, r0, th0, sweep, r1), math.hypot((r0 + r1) / 2 * sweep, rest))
         if abs(r1 - r0) > 1e-12:
-            self.elements[-1].extra_mm = abs(r1 - r0) + 1e-3
+            el = self.elements[-1]
+            el.extra_mm = abs(r1 - r0) + min(1e-3, _bisector_offset(el, su, sv, eu, ev))
 
     def _centre_from_radius(self, su, sv, eu, ev, radius, ccw):
         chord = math.hypot(eu - su, ev - sv)
@@ -218,6 +221,38 @@ class Model:
         nu, nv = -(ev - sv) / chord, (eu - su) / chord
         sign = 1 if left else -1
         return mu + sign * h * nu, mv + sign * h * nv
+
+
+def _bisector_offset(el, su, sv, eu, ev):
+    """How far the arc with its centre moved onto the chord's perpendicular bisector (as
+    motion/src/geometry.cpp does) lies from the element's spiral, over 256 points along both."""
+    u, v, cu, cv, r0, th0, sweep, r1 = el.arc
+    chord_u, chord_v = eu - su, ev - sv
+    chord = math.hypot(chord_u, chord_v)
+    if chord < 1e-9:
+        return 0.0
+    mu, mv = (su + eu) / 2, (sv + ev) / 2
+    nu, nv = -chord_v / chord, chord_u / chord
+    t = (cu - mu) * nu + (cv - mv) * nv
+    bu, bv = mu + t * nu, mv + t * nv
+    rb = math.hypot(su - bu, sv - bv)
+    b0 = math.atan2(sv - bv, su - bu)
+    b_sweep = math.atan2(ev - bv, eu - bu) - b0
+    if sweep > 0 and b_sweep <= 1e-12:
+        b_sweep += TWO_PI
+    if sweep < 0 and b_sweep >= -1e-12:
+        b_sweep -= TWO_PI
+    worst = 0.0
+    for k in range(257):
+        f = k / 256
+        p = el.point(f)
+        # Distance of the planner's point at the same fraction from the spiral, and back, in
+        # the plane (the other axes move alike in both).
+        a = b0 + b_sweep * f
+        q = (bu + rb * math.cos(a), bv + rb * math.sin(a))
+        worst = max(worst, abs(math.hypot(q[0] - cu, q[1] - cv) - (r0 + (r1 - r0) * f)),
+                    abs(math.hypot(p[u] - bu, p[v] - bv) - rb))
+    return worst
 
 
 def model_of(lines, machine):

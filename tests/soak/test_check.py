@@ -122,12 +122,27 @@ class PathCheck(unittest.TestCase):
         circle = [[round(x, 6) for x in arc.point(k / 3000)] for k in range(3001)]
         self.assertIsNone(check.check_path(trace_of(rapid + circle, [1] * len(rapid) + [2] * 3001), model))
 
+    def test_steep_helix_distance_against_brute_force(self):
+        """A G19 helix (radius 0.67 mm, 2.8 mm of X over 294 degrees): its nearest point is not at
+        the sample's angle (the check's first helix distance said 0.0105 mm where the helix
+        passes 0.0089 mm away, a false failure of soak mill seed 151)."""
+        model = model_of(["G0 X286.4153 Y282.6912 Z-69.46", "G19",
+                          "G3 Y281.9921 Z-69.6776 X289.1812 R-0.6704 F515.6", "M30"], self.m)
+        helix = model.elements[-1]
+        dense = [helix.point(k / 200000) for k in range(200001)]
+        rng = __import__("random").Random(5)
+        for q in ([286.425353, 282.692869, -69.462591],
+                  *([286.4153 + rng.uniform(0, 2.8), 282.17 + rng.uniform(-0.8, 0.8),
+                     -69.03 + rng.uniform(-0.8, 0.8)] for _ in range(5))):
+            brute = min(math.dist(q, p) for p in dense)
+            self.assertAlmostEqual(check.distance(helix, q), brute, delta=2e-6, msg=q)
+
     def test_arc_and_helix_distances(self):
         model = model_of(["F600", "G0 X20 Y10", "G3 X10 Y20 Z-3 I-10 J0", "M30"], self.m)
         arc = model.elements[-1]
         self.assertIsNotNone(arc.arc)
         for f in (0.0, 0.3, 0.77, 1.0):
-            self.assertLess(check.distance(arc, arc.point(f)), 1e-9)
+            self.assertLess(check.distance(arc, arc.point(f)), 1e-7)
         p = arc.point(0.5)  # 45 degrees on the circle about (10, 10): move outward 0.05 mm
         q = [p[0] + 0.05 / math.sqrt(2), p[1] + 0.05 / math.sqrt(2), p[2]]
         self.assertAlmostEqual(check.distance(arc, q), 0.05, delta=0.05 * 0.01)
