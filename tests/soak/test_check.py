@@ -58,10 +58,11 @@ class PathCheck(unittest.TestCase):
         self.assertIsNotNone(f)
         self.assertEqual(f.check, "path")
         self.assertAlmostEqual(f.trace_t_s, 0.501)
-        # On an exact path only the rounding of the printed numbers is allowed: sqrt(3) * 0.5e-6 mm.
-        pts[500][1] = self.pts[500][1] + 0.8e-6
+        # On an exact path only the rounding of the printed numbers (sqrt(3) * 0.5e-6 mm) and 1e-6 mm
+        # of arithmetic are allowed.
+        pts[500][1] = self.pts[500][1] + 1.8e-6
         self.assertIsNone(check.check_path(trace_of(pts, self.lines), self.model))
-        pts[500][1] = self.pts[500][1] + 1.2e-6
+        pts[500][1] = self.pts[500][1] + 2.2e-6
         self.assertIsNotNone(check.check_path(trace_of(pts, self.lines), self.model))
 
     def test_within_the_blend_tolerance_passes(self):
@@ -84,6 +85,14 @@ class PathCheck(unittest.TestCase):
         self.assertIsNone(check.check_path(trace_of(pts, [2] * (len(pts) - 205) + [4] * 205), model))
         pts[-300][1] = 0.0102  # beyond P0.01 of line 2 and off line 4
         self.assertIsNotNone(check.check_path(trace_of(pts, [2] * (len(pts) - 205) + [4] * 205), model))
+
+    def test_a_path_that_reverses_onto_itself(self):
+        """soak corexy seed 12: G0 Z down then straight back up; on the way up the tool is on
+        both moves, and must be taken on the second (it was kept on the first, going back, until
+        the window left it 3 mm up)."""
+        model = model_of(["G0 Z-20", "G0 Z-5", "M30"], self.m)
+        pts = smooth_move([0, 0, 0], [0, 0, -20], 1.0) + smooth_move([0, 0, -20], [0, 0, -5], 1.0)
+        self.assertIsNone(check.check_path(trace_of(pts, [1] * 1005 + [2] * 1005), model))
 
     def test_running_the_path_backwards_fails(self):
         f = check.check_path(trace_of(list(reversed(self.pts))), self.model)
@@ -136,6 +145,24 @@ class PathCheck(unittest.TestCase):
                      -69.03 + rng.uniform(-0.8, 0.8)] for _ in range(5))):
             brute = min(math.dist(q, p) for p in dense)
             self.assertAlmostEqual(check.distance(helix, q), brute, delta=2e-6, msg=q)
+
+    def test_elements_outside_the_window_are_not_candidates(self):
+        """soak corexy seed 12: while the tool stood at the corner before a full circle, the line
+        after the circle (starting at the same point, 31 mm of path ahead) was taken at the
+        window's end with the distance of its start, and the farthest point reached jumped 2 mm
+        a period."""
+        model = model_of(["F600", "G1 X10", "G64 P0.02", "G2 I-5", "G1 X30", "M30"], self.m)
+        els = model.elements
+        cum = [0.0]
+        for e in els:
+            cum.append(cum[-1] + e.length_mm)
+        at_corner = [10.0, 0.0, 0.0]
+        self.assertIsNone(check._pick(els, cum, [2], at_corner, 10.0, 10.0, 3))
+        # The circle's start, not its end (31 mm ahead), though the sample projects a hair
+        # behind where the last one did.
+        _, d, s, i, _ = check._pick(els, cum, [0, 1, 2], at_corner, 10.001, 10.001, 3)
+        self.assertEqual(i, 1)
+        self.assertAlmostEqual(s, 10.0, places=6)
 
     def test_arc_and_helix_distances(self):
         model = model_of(["F600", "G0 X20 Y10", "G3 X10 Y20 Z-3 I-10 J0", "M30"], self.m)
