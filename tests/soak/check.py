@@ -280,11 +280,12 @@ def _allowed(els, i, axes):
 
 
 def _pick(els, cum, indices, q, s_last, s_max, axes):
-    """(excess, distance, path position s, element) of the point of the path within the window
-    about s_max that the sample is nearest to relative to its allowance (excess = distance -
-    allowed there: a sample near two elements needs to be within the tolerance of one of them).
-    A nearest point outside the window is replaced by the window's end on that element. Ties go
-    to the point that continues from s_last."""
+    """(excess, distance, path position s, element, element of the least excess) of the point of
+    the path within the window about s_max that the sample is nearest to relative to its
+    allowance (excess = distance - allowed there: a sample near two elements needs to be within
+    the tolerance of one of them); None if every element lies outside the window. A nearest
+    point outside the window is replaced by the window's end on that element. Ties (within the
+    trace's resolution) go to the point that does not go back from s_max and is nearest s_last."""
     cands = []
     for i in indices:
         e = els[i]
