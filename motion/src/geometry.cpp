@@ -11,6 +11,8 @@ namespace motion {
 namespace {
 
 constexpr double kTwoPi = 2 * std::numbers::pi;
+// The interpreter's default ARC_TOLERANCE_MM (FEATURES ARC-11).
+constexpr double kArcEndOffCircle_mm = 0.01;
 
 double norm(const AxisArray& v) {
     double s = 0;
@@ -275,6 +277,55 @@ Element make_line(const AxisArray& start, const AxisArray& end) noexcept {
     return Element{ElementKind::Line, length, start, a, zero, zero, end, 0, 0, 0};
 }
 
+// The signed sweep from angle th0 to th1 in the direction and with the extra whole turns of
+// `turns` (G2 < 0 < G3; |turns| > 1 adds circles).
+double arc_sweep(double th0, double th1, int turns) {
+    double sweep = th1 - th0;
+    const int extra = std::abs(turns) - 1;
+    if (turns > 0) {
+        if (sweep <= 1e-12) sweep += kTwoPi;
+        return sweep + kTwoPi * extra;
+    }
+    if (sweep >= -1e-12) sweep -= kTwoPi;
+    return sweep - kTwoPi * extra;
+}
+
+struct PlaneArc {
+    double cu, cv, r, th0, sweep;
+    double u(double th) const { return cu + r * std::cos(th); }
+    double v(double th) const { return cv + r * std::sin(th); }
+};
+
+// Distance from (pu, pv) to the arc (not its whole circle).
+double distance_to_arc(double pu, double pv, const PlaneArc& a) {
+    if (std::fabs(a.sweep) < kTwoPi) {
+        const double phi = std::atan2(pv - a.cv, pu - a.cu);
+        double into = a.sweep > 0 ? phi - a.th0 : a.th0 - phi;  // how far along, either way round
+        into = std::fmod(std::fmod(into, kTwoPi) + kTwoPi, kTwoPi);
+        if (into > std::fabs(a.sweep)) {
+            const double end = a.th0 + a.sweep;
+            return std::min(std::hypot(pu - a.u(a.th0), pv - a.v(a.th0)),
+                            std::hypot(pu - a.u(end), pv - a.v(end)));
+        }
+    }
+    return std::fabs(std::hypot(pu - a.cu, pv - a.cv) - a.r);
+}
+
+// How far apart two arcs are (each point of either to the other, sampled finely): what moving
+// an arc's centre does to its path. Rarely needed, so plain sampling.
+double arcs_apart(const PlaneArc& a, const PlaneArc& b) {
+    const int n = 32 * static_cast<int>(std::ceil(std::max(std::fabs(a.sweep), std::fabs(b.sweep)) /
+                                                  (kTwoPi / 8)));
+    double apart = 0;
+    for (int k = 0; k <= n; ++k) {
+        const double f = static_cast<double>(k) / n;
+        const double tha = a.th0 + f * a.sweep, thb = b.th0 + f * b.sweep;
+        apart = std::max({apart, distance_to_arc(a.u(tha), a.v(tha), b),
+                          distance_to_arc(b.u(thb), b.v(thb), a)});
+    }
+    return apart;
+}
+
 Element make_arc(const AxisArray& start, const PathSegment& seg) {
     int i = seg.plane_first, j = seg.plane_second, n = seg.plane_normal;
     auto valid = [](int ax) { return ax >= 0 && ax < kAxes; };
@@ -288,33 +339,47 @@ Element make_arc(const AxisArray& start, const PathSegment& seg) {
     if (r0 < 1e-9) throw PlanError(seg.line, "arc radius is zero (centre at the start point)");
     // LinuxCNC-like acceptance: small rounding of the programmed end is absorbed by moving the
     // centre onto the chord's perpendicular bisector; anything larger is a programming error.
-    double mismatch = std::fabs(r1 - r0);
-    if (mismatch > std::max(0.005, 1e-3 * r0))
+    // The allowance is the interpreter's default (ARC_TOLERANCE_MM, 0.01 mm), so that what
+    // `cnc check` accepts runs.
+    const double mismatch = std::fabs(r1 - r0), allowed_mm = std::max(kArcEndOffCircle_mm, 1e-3 * r0);
+    if (mismatch > allowed_mm)
         throw PlanError(seg.line, "arc end is not on the circle: start radius " +
                                       std::to_string(r0) + " mm, end radius " + std::to_string(r1) +
                                       " mm");
-    double chord_u = seg.end_mm[i] - start[i], chord_v = seg.end_mm[j] - start[j];
-    double chord = std::hypot(chord_u, chord_v);
+    const double chord_u = seg.end_mm[i] - start[i], chord_v = seg.end_mm[j] - start[j];
+    const double chord = std::hypot(chord_u, chord_v);
     if (mismatch > 0 && chord > 1e-9) {
-        double mu = (start[i] + seg.end_mm[i]) / 2, mv = (start[j] + seg.end_mm[j]) / 2;
-        double nu = -chord_v / chord, nv = chord_u / chord;  // bisector direction
-        double t = (cu - mu) * nu + (cv - mv) * nv;
+        const PlaneArc programmed{cu, cv, r0, std::atan2(sv, su),
+                                  arc_sweep(std::atan2(sv, su), std::atan2(ev, eu), seg.turns)};
+        const double mu = (start[i] + seg.end_mm[i]) / 2, mv = (start[j] + seg.end_mm[j]) / 2;
+        const double nu = -chord_v / chord, nv = chord_u / chord;  // bisector direction
+        const double t = (cu - mu) * nu + (cv - mv) * nv;
+        const double moved_mm = std::hypot(mu + t * nu - cu, mv + t * nv - cv);
         cu = mu + t * nu;
         cv = mv + t * nv;
         su = start[i] - cu, sv = start[j] - cv;
         eu = seg.end_mm[i] - cu, ev = seg.end_mm[j] - cv;
         r0 = std::hypot(su, sv);
+        // Every point of the moved circle is within moved + |r0 change| of the programmed one,
+        // which settles almost every arc at once. A short chord can move the centre far: on a
+        // short arc the path hardly changes, but a nearly full circle whose end is a little off
+        // its start becomes another circle through the two close points, a dot (X100 Y100,
+        // G2 X100.004 Y100 I-5: radius 0.002 mm). Such an arc is refused, not run.
+        if (moved_mm + std::fabs(r0 - programmed.r) > allowed_mm) {
+            const PlaneArc moved{cu, cv, r0, std::atan2(sv, su),
+                                 arc_sweep(std::atan2(sv, su), std::atan2(ev, eu), seg.turns)};
+            const double apart_mm = arcs_apart(programmed, moved);
+            if (apart_mm > allowed_mm)
+                throw PlanError(seg.line,
+                                "arc end is " + std::to_string(mismatch) +
+                                    " mm off the circle, and the only circle through both ends "
+                                    "leaves the programmed arc by " +
+                                    std::to_string(apart_mm) +
+                                    " mm (a nearly full circle): program the end on the circle");
+        }
     }
-    double th0 = std::atan2(sv, su), th1 = std::atan2(ev, eu);
-    double sweep = th1 - th0;
-    int extra = std::abs(seg.turns) - 1;
-    if (seg.turns > 0) {
-        if (sweep <= 1e-12) sweep += kTwoPi;
-        sweep += kTwoPi * extra;
-    } else {
-        if (sweep >= -1e-12) sweep -= kTwoPi;
-        sweep -= kTwoPi * extra;
-    }
+    const double th0 = std::atan2(sv, su), th1 = std::atan2(ev, eu);
+    const double sweep = arc_sweep(th0, th1, seg.turns);
     // Built with every member given (see make_line): `Element e;` cleared it with rep stos.
     AxisArray origin = start, a{}, b{}, c;
     origin[i] = cu;

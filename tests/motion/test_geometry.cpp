@@ -162,6 +162,74 @@ TEST(Geometry, SmallEndRoundingMovesTheCentreOntoTheBisector) {
     EXPECT_LT(dist(near_end.p, seg.end_mm), 1e-9);
 }
 
+// The largest distance of the element's in-plane path (X, Y) from the circle about (cu, cv) of
+// radius r, sampled.
+double off_circle_mm(const Element& e, double cu, double cv, double r) {
+    double off = 0;
+    for (int k = 0; k <= 1000; ++k) {
+        CurvePoint cp;
+        evaluate(e, e.length_mm * k / 1000, cp);
+        off = std::max(off, std::fabs(std::hypot(cp.p[0] - cu, cp.p[1] - cv) - r));
+    }
+    return off;
+}
+
+// Found by the end-to-end soak (docs/soak.md): a G2 from X100 Y100 about X95 Y100 to
+// X100.004 Y100. The only circles through both ends have their centres on x = 100.002; the
+// nearest to the programmed centre is a dot of radius 0.002 mm, which the planner ran instead
+// of the 31.4 mm circle.
+TEST(Geometry, NearlyFullCircleWhoseEndMissesItsStartIsRefusedNotRunAsAnotherCircle) {
+    PathSegment seg;
+    seg.kind = SegmentKind::Arc;
+    seg.line = 3;
+    seg.end_mm = {100.004, 100, 0};
+    seg.centre_mm = {95, 100};
+    seg.turns = -1;
+    try {
+        const Element e = make_arc({100, 100, 0}, seg);
+        FAIL() << "ran as an arc of radius " << e.radius_mm << " mm, " << e.length_mm << " mm long";
+    } catch (const PlanError& e) {
+        EXPECT_EQ(e.line(), 3);
+        const std::string what = e.what();
+        EXPECT_NE(what.find("arc end is 0.004000 mm off the circle"), std::string::npos) << what;
+        EXPECT_NE(what.find("program the end on the circle"), std::string::npos) << what;
+    }
+}
+
+// The centre still moves where that keeps the path: a 10 degree arc of radius 5 whose end is
+// 0.005 mm outside the circle moves its centre by about r * 0.005 / chord = 0.029 mm, but
+// its path stays within 0.01 mm of the programmed circle.
+TEST(Geometry, ShortArcWithARoundedEndMovesItsCentreAndKeepsToTheCircle) {
+    const double r = 5, a = 10 * std::numbers::pi / 180, out = 0.005;
+    PathSegment seg;
+    seg.kind = SegmentKind::Arc;
+    seg.end_mm = {(r + out) * std::cos(a), (r + out) * std::sin(a), 0};
+    seg.centre_mm = {0, 0};
+    seg.turns = 1;
+    const Element e = make_arc({r, 0, 0}, seg);
+    EXPECT_GT(std::hypot(e.origin[0], e.origin[1]), 0.02);  // the centre did move
+    EXPECT_LE(off_circle_mm(e, 0, 0, r), out + 1e-9);
+    EXPECT_NEAR(e.length_mm, r * a, 0.01);
+    CurvePoint end;
+    evaluate(e, e.length_mm, end);
+    EXPECT_EQ(end.p, seg.end_mm);
+}
+
+// What the interpreter accepts (ARC_TOLERANCE_MM, 0.01 mm by default) runs: a half circle of
+// radius 2 ending 0.008 mm off (the planner refused more than 0.005 mm on small arcs, so
+// `cnc check` passed a program `cnc run` then refused).
+TEST(Geometry, EndOffTheCircleByWhatTheInterpreterAcceptsRuns) {
+    PathSegment seg;
+    seg.kind = SegmentKind::Arc;
+    seg.end_mm = {-2.008, 0, 0};
+    seg.centre_mm = {0, 0};
+    seg.turns = 1;
+    const Element e = make_arc({2, 0, 0}, seg);
+    EXPECT_LE(off_circle_mm(e, 0, 0, 2), 0.008 + 1e-9);
+    seg.end_mm = {-2.011, 0, 0};
+    EXPECT_THROW(make_arc({2, 0, 0}, seg), PlanError);
+}
+
 TEST(Geometry, BlendStaysWithinItsDeviationAndJoinsTangentially) {
     std::mt19937_64 rng(3);
     for (int trial = 0; trial < 500; ++trial) {
