@@ -24,6 +24,27 @@ constexpr int kMaxDepth = 40;
 // Rounding of the inverse kinematics (the servo check's kJointLimitRoundingMm).
 constexpr double kRounding = 1e-9;
 constexpr int kFirstRotary = 3, kLastRotary = 5;  // A, B, C
+// Joint rates (see "Joint rates at plan time" in the header).
+constexpr double kRateStep = 1e-3;       // mm or degrees along the tangent and curvature
+constexpr double kRateTolerance = 1e-3;  // allowance 2 |d| within this share of the bound
+constexpr double kRateFloor = 1e-6;      // ... or below this (joint units per mm, per mm^2)
+constexpr int kMaxRateDepth = 10;        // halvings of a piece
+constexpr double kSlowestCapMmS = 1e-6;  // the planner needs a speed > 0
+
+// The largest |f| on an interval from f at its ends and middle (the parabola allowance), and
+// whether the allowance is small against it.
+struct RateBound {
+    double bound;
+    bool fine;
+};
+RateBound rate_bound(double f0, double fm, double f1) noexcept {
+    const double d = std::fabs(fm - 0.5 * (f0 + f1));
+    const double hi = std::max({f0, fm, f1}) + kCurvatureFactor * d;
+    const double lo = std::min({f0, fm, f1}) - kCurvatureFactor * d;
+    const double bound = std::max(std::fabs(hi), std::fabs(lo));
+    // NaN (a point the kinematics cannot reach) is never fine: halved to the depth limit.
+    return {bound, kCurvatureFactor * d <= kRateTolerance * bound + kRateFloor};
+}
 
 int piece_count(const motion::Element& e, const motion::AxisArray& start) {
     double pieces = 1;
@@ -44,6 +65,11 @@ JointLimitCheck::JointLimitCheck(JointLimitConfig cfg) : cfg_(std::move(cfg)) {
                                     " joints; motion checks at most " + std::to_string(kMaxJoints));
     if (cfg_.min_limit.size() != joints_ || cfg_.max_limit.size() != joints_)
         throw std::invalid_argument("joint limits given for another number of joints");
+    if (!cfg_.max_velocity.empty() &&
+        (cfg_.max_velocity.size() != joints_ || cfg_.max_acceleration.size() != joints_))
+        throw std::invalid_argument("joint rate limits given for another number of joints");
+    if (!(cfg_.max_rate >= 1 && std::isfinite(cfg_.max_rate)))
+        throw std::invalid_argument("max_rate must be >= 1 and finite");
 }
 
 void JointLimitCheck::set_tool_offset(double tool_offset_mm) noexcept {
@@ -182,6 +208,88 @@ void JointLimitCheck::maximise(const motion::Element& e, Excess& excess, double 
     if (depth >= 2 * kMaxDepth || s1 - s0 <= 1e-12 * e.length_mm) return;
     maximise(e, excess, s0, g0, sm, gm, depth + 1, f);
     maximise(e, excess, sm, gm, s1, g1, depth + 1, f);
+}
+
+// g = J(p) p' and h = D2q(p)[p', p'] (q the inverse kinematics, p(s) the path) by central
+// differences along p'. h is the kinematics' own curvature: what the joints add to the path's
+// (J(p) p'', which the planner limits through the axes); zero for a kinematics linear in the
+// axes that move.
+void JointLimitCheck::rates_at(const motion::Element& e, double s_mm, Rates& out) const noexcept {
+    motion::CurvePoint cp;
+    motion::evaluate_upto(e, s_mm, 1, cp);
+    const motion::Kinematics& k = cfg_.kins->kins();
+    Joints q0, qp, qm;
+    auto along = [&](double step, Joints& q) {
+        motion::AxisArray p = cp.p;
+        for (int a = 0; a < motion::kAxes; ++a) p[a] += step * cp.d1[a];
+        k.inverse(p, std::span<double>(q.data(), joints_));
+    };
+    k.inverse(cp.p, std::span<double>(q0.data(), joints_));
+    along(kRateStep, qp);
+    along(-kRateStep, qm);
+    for (std::size_t n = 0; n < joints_; ++n) {
+        out.g[n] = (qp[n] - qm[n]) / (2 * kRateStep);
+        out.h[n] = (qp[n] - 2 * q0[n] + qm[n]) / (kRateStep * kRateStep);
+    }
+}
+
+void JointLimitCheck::bound_rates(const motion::Element& e, double s0, const Rates& r0, double s1,
+                                  const Rates& r1, int depth, Joints& g_max,
+                                  Joints& h_max) const noexcept {
+    const double sm = 0.5 * (s0 + s1);
+    Rates rm;
+    rates_at(e, sm, rm);
+    Joints g, h;
+    bool fine = true;
+    for (std::size_t n = 0; n < joints_; ++n) {
+        const RateBound bg = rate_bound(r0.g[n], rm.g[n], r1.g[n]);
+        const RateBound bh = rate_bound(r0.h[n], rm.h[n], r1.h[n]);
+        g[n] = bg.bound;
+        h[n] = bh.bound;
+        fine = fine && bg.fine && (cfg_.max_acceleration[n] <= 0 || bh.fine);
+    }
+    if (fine || depth >= kMaxRateDepth) {
+        for (std::size_t n = 0; n < joints_; ++n) {
+            // std::max would drop a NaN bound: the joint is then unbounded.
+            g_max[n] = std::isnan(g[n]) ? INFINITY : std::max(g_max[n], g[n]);
+            h_max[n] = std::isnan(h[n]) ? INFINITY : std::max(h_max[n], h[n]);
+        }
+        return;
+    }
+    bound_rates(e, s0, r0, sm, rm, depth + 1, g_max, h_max);
+    bound_rates(e, sm, rm, s1, r1, depth + 1, g_max, h_max);
+}
+
+double JointLimitCheck::speed_cap_mm_s(const motion::Element& e,
+                                       double axes_speed_mm_s) const noexcept {
+    if (!cfg_.kins || cfg_.max_velocity.size() != joints_ || !(e.length_mm > 0)) return INFINITY;
+    Joints g_max{}, h_max{};
+    const int pieces = piece_count(e, motion::point_at(e, 0));
+    Rates r0, r1;
+    rates_at(e, 0, r0);
+    double s0 = 0;
+    for (int i = 1; i <= pieces; ++i) {
+        const double s1 = i == pieces ? e.length_mm : e.length_mm * i / pieces;
+        rates_at(e, s1, r1);
+        bound_rates(e, s0, r0, s1, r1, 0, g_max, h_max);
+        s0 = s1;
+        r0 = r1;
+    }
+    // The axes keep the path speed at or below axes_speed_mm_s at any override: a joint whose
+    // own speed bound is not below that needs no cap; one that is gets it at the highest
+    // override.
+    double cap = INFINITY;
+    for (std::size_t n = 0; n < joints_; ++n) {
+        if (const double v = cfg_.max_velocity[n]; v > 0 && g_max[n] > 0)
+            cap = std::min(cap, v / g_max[n]);
+        if (const double a = cfg_.max_acceleration[n]; a > 0 && h_max[n] > 0)
+            cap = std::min(cap, std::sqrt(kCurvatureAccShare * a / h_max[n]));
+    }
+    // A joint that mirrors an axis (C, or X on a level table) has the axis's bound, give or
+    // take the allowance: within it the axes' speed is kept (the joint may then reach
+    // 1 + kRateTolerance times its limit, the servo check's slack).
+    if (!(cap < axes_speed_mm_s * (1 - kRateTolerance))) return INFINITY;
+    return std::max(cap / cfg_.max_rate, kSlowestCapMmS);
 }
 
 std::optional<JointViolation> JointLimitCheck::check(const motion::Element& e) {

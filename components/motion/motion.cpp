@@ -1074,6 +1074,15 @@ class Motion : public hal::Instance {
                                              c.joints.max_limit[j]));
         }
         c.joints.pin_stem = pin_name("joint");
+        // The planner limits a linear kinematics' joints itself (planner_config()); any other
+        // kinematics' joint rates are planned by the sink, move by move (joint_limits.hpp).
+        if (kins_.kins().linear_map().empty()) {
+            for (std::size_t j = 0; j < joint_count_; ++j) {
+                c.joints.max_velocity.push_back(joint_max_velocity_[j].get());
+                c.joints.max_acceleration.push_back(joint_max_acceleration_[j].get());
+            }
+            c.joints.max_rate = kMaxOverride;
+        }
         c.digital_outputs = static_cast<int>(num_dio_);
         c.digital_inputs = static_cast<int>(num_dio_);
         return c;

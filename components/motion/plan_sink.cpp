@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <set>
@@ -375,11 +376,7 @@ class Sink final : public PlanSink {
     // The joints along the move's path (joint_limits.hpp), before the planner has it: a move
     // that would take a motor past its travel is refused at its line, and the machine comes to
     // rest where the move before ended.
-    void check_joint_limits(const interp::SourceLoc& loc, const motion::PathSegment& seg) {
-        if (!joint_check_.config().kins) return;
-        const motion::Element path = seg.kind == motion::SegmentKind::Arc
-                                         ? motion::make_arc(pos_mm_, seg)
-                                         : motion::make_line(pos_mm_, seg.end_mm);
+    void check_joint_limits(const interp::SourceLoc& loc, const motion::Element& path) {
         const std::optional<JointViolation> v = joint_check_.check(path);
         if (!v) return;
         const JointLimitConfig& jc = joint_check_.config();
@@ -422,10 +419,39 @@ class Sink final : public PlanSink {
         throw interp::Error(loc, reason);
     }
 
-    void push(const interp::SourceLoc& loc, const motion::PathSegment& seg) {
-        check_soft_limits(loc, seg);
+    // Under a kinematics the planner has no joint map of, the move goes no faster than keeps
+    // every joint within joint.N.max-velocity (joint_limits.hpp, "Joint rates"): a feed is
+    // lowered to that speed, a rapid gets it as its rapid rate.
+    static motion::PathSegment with_speed_cap(const motion::PathSegment& seg, double cap_mm_s) {
+        motion::PathSegment out = seg;
+        if (!(cap_mm_s < std::numeric_limits<double>::infinity())) return out;
+        if (seg.rapid)
+            out.rapid_mm_s = seg.rapid_mm_s > 0 ? std::min(seg.rapid_mm_s, cap_mm_s) : cap_mm_s;
+        else
+            out.feed_mm_s = std::min(seg.feed_mm_s, cap_mm_s);
+        return out;
+    }
+
+    // The highest path speed the axes' velocity limits allow anywhere on `path`.
+    double axes_speed_mm_s(const motion::Element& path) const {
+        const motion::ElementBounds b = motion::bounds(path);
+        double v = std::numeric_limits<double>::infinity();
+        for (int k = 0; k < motion::kAxes; ++k)
+            if (b.g1[k] > 0) v = std::min(v, cfg_.plan.limits.vel_mm_s[k] / b.g1[k]);
+        return v;
+    }
+
+    void push(const interp::SourceLoc& loc, const motion::PathSegment& programmed) {
+        check_soft_limits(loc, programmed);
         try {
-            check_joint_limits(loc, seg);
+            motion::PathSegment seg = programmed;
+            if (joint_check_.config().kins) {
+                const motion::Element path = seg.kind == motion::SegmentKind::Arc
+                                                 ? motion::make_arc(pos_mm_, seg)
+                                                 : motion::make_line(pos_mm_, seg.end_mm);
+                check_joint_limits(loc, path);
+                seg = with_speed_cap(seg, joint_check_.speed_cap_mm_s(path, axes_speed_mm_s(path)));
+            }
             // The look-ahead closed (M802 P196609): the block before ends at rest first.
             if (buffer_closed_ && seg.line != last_move_line_) rest(nullptr);
             last_move_line_ = seg.line;
@@ -433,7 +459,7 @@ class Sink final : public PlanSink {
         } catch (const motion::PlanError& e) {
             rethrow_with_file(loc, e);
         }
-        pos_mm_ = seg.end_mm;
+        pos_mm_ = programmed.end_mm;
         off_path_ = false;
         feeder_.collect();
     }
