@@ -450,7 +450,9 @@ class Sink final : public PlanSink {
                                                  ? motion::make_arc(pos_mm_, seg)
                                                  : motion::make_line(pos_mm_, seg.end_mm);
                 check_joint_limits(loc, path);
-                seg = with_speed_cap(seg, joint_check_.speed_cap_mm_s(path, axes_speed_mm_s(path)));
+                if (!joint_check_.config().max_velocity.empty())  // a nonlinear kinematics
+                    seg = with_speed_cap(seg,
+                                         joint_check_.speed_cap_mm_s(path, axes_speed_mm_s(path)));
             }
             // The look-ahead closed (M802 P196609): the block before ends at rest first.
             if (buffer_closed_ && seg.line != last_move_line_) rest(nullptr);
