@@ -70,6 +70,19 @@ constexpr double kOffsetMinCos = -0.02;
 constexpr double kShiftSpeedFactor = 3;
 constexpr double kShiftCentripetal = 0.5;
 constexpr double kShiftMinSpeedFactor = 2;
+// A lane change onto or off a line whose outward normal lies at least kAxisShiftMinNormal along
+// one axis moves the tool along that axis only (lane_change_direction): on tp_default's sine
+// rows (11 degrees off X at the X0 row end) a shift along the normal also moves X, whose
+// acceleration the shift then shares with its turning sideways (898 instead of 990 mm/s^2 for
+// 19 ms). A line of at most kShortMoveRoom_mm may give kShortMoveRoomShare of itself to the
+// shift back (instead of half: the corner at its far end may take the other half), as a row's
+// 0.5 mm steps turn by 1 degree at that end and need a few hundredths of a millimetre there.
+// Measured on the bench programs (docs/benchmarks.md, "Row ends within P"): tp_default -2 ms,
+// surface_3d at P0.001 -8 ms, nothing slower; half of the next line, or 0.9 of lines up to
+// any length, left tp_default as it was or cost pocket_sharp 8 ms.
+constexpr double kAxisShiftMinNormal = 0.9;
+constexpr double kShortMoveRoom_mm = 1.0;
+constexpr double kShortMoveRoomShare = 0.9;
 // One-sided offset corners (one_sided_offset_corner): where one line has no room for a shift,
 // only the other is moved outwards, by kOffsetShare of the tolerance; the turn is the parabola
 // between that offset line and the other line as programmed. Up to 90 degrees its cut may be
@@ -252,7 +265,10 @@ void Planner::classify(const Piece& p, const Piece& next, Junction& jn) const {
             {1 - reserve_, 1 - reserve_, mixed && lines ? kIsolatedBlendCentripetal : 0.0});
     }
     if (lines && p.tolerance_mm > 0) {
-        double l = std::min(p.geom.length_mm, next.geom.length_mm) / 2;
+        // Half of each line, and no more than the corner at p's start left of it (an offset
+        // corner's shift back may take more than half of a short line).
+        double l = std::min(std::min(p.geom.length_mm, next.geom.length_mm) / 2,
+                            p.geom.length_mm - p.trim_start_mm);
         // A (near) reversal stops at its end point: the axis passes through zero speed there
         // anyway, so a blend saves almost nothing and would leave the bottom of a drilled
         // hole sqrt(2) tol short (the miss every turn past 90 degrees is allowed, see above).
@@ -482,6 +498,38 @@ double offset_first_cut(double share, double tol, double sin_angle, double l_spe
                     std::max(l_speed_mm, kSpeedCutFloor * tol));
 }
 
+// The direction a lane change off or onto a line (unit tangent t, outward unit normal n) moves
+// the tool by d: d times it lies d outwards, n itself unless n lies at least
+// kAxisShiftMinNormal along an axis j and t has a part along j, then n + (t_j / n_j) t, which
+// keeps the tool's motion along the other axes of the corner's plane as on the line (in two
+// axes exactly: with t = (c, s), n = (-s, c), its first component is -s + (s / c) c = 0).
+// `along` is t_j / n_j, how far it moves the tool along the line per unit outwards (0 for n).
+struct LaneChange {
+    AxisArray w;
+    double along = 0;
+};
+LaneChange lane_change_direction(const AxisArray& t, const AxisArray& n) {
+    int j = 0;
+    for (int k = 1; k < kAxes; ++k)
+        if (std::fabs(n[k]) > std::fabs(n[j])) j = k;
+    LaneChange lc{n, 0};
+    if (!(std::fabs(n[j]) >= kAxisShiftMinNormal) || t[j] == 0) return lc;
+    lc.along = t[j] / n[j];
+    for (int k = 0; k < kAxes; ++k) lc.w[k] = n[k] + lc.along * t[k];
+    return lc;
+}
+
+// Room a line after a corner leaves for the shift back onto it (see kShortMoveRoom_mm): half
+// of it, or kShortMoveRoomShare of a short one whose lane change runs along an axis.
+double shift_back_room_mm(const Element& next, const AxisArray& n2) {
+    double largest = 0;
+    for (double x : n2) largest = std::max(largest, std::fabs(x));
+    if (next.kind == ElementKind::Line && next.length_mm <= kShortMoveRoom_mm &&
+        largest >= kAxisShiftMinNormal)
+        return kShortMoveRoomShare * next.length_mm;
+    return max_trim_mm(next, 0);
+}
+
 // An offset corner's cuts for a turn cut lp whose middle lies `share` tol inside the corner,
 // between moves carried d outwards (only as far as that cut needs: each mm of offset lengthens
 // the path by 2 tan(angle / 2)); `back` = d tan(angle / 2). The shifts are cut so that they
@@ -547,23 +595,37 @@ bool Planner::offset_corner(const Piece& p, const Piece& next, const OffsetFrame
     const double tol = p.tolerance_mm;
     // The parabola may now lie up to d + kOffsetShare tol from the offset lines. Room for the
     // shifts: what the first line has left after the corner at its start (known by now), half
-    // of the second (the corner at its end may take the other half).
+    // of the second (the corner at its end may take the other half), more of a short one
+    // (shift_back_room_mm).
     const AxisArray &n1 = f.n1, &n2 = f.n2;
     const double lp = offset_first_cut(kOffsetShare, tol, sin_angle, l_speed_mm);
+    const double room1 = p.geom.length_mm - p.trim_start_mm;
+    const double room2 = shift_back_room_mm(next.geom, n2);
     OffsetCuts cuts;
-    if (!offset_cuts(lp, kOffsetShare, tol, sin_angle, cos_t, sin_t, f,
-                     p.geom.length_mm - p.trim_start_mm, max_trim_mm(next.geom, 0), cuts))
+    if (!offset_cuts(lp, kOffsetShare, tol, sin_angle, cos_t, sin_t, f, room1, room2, cuts))
         return false;
-    const double d = cuts.d, ls1 = cuts.ls1, ls2 = cuts.ls2;
-    const double cut_before_mm = cuts.before_mm, cut_after_mm = cuts.after_mm;
+    const double d = cuts.d;
+    // Each shift moves the tool d outwards along lane_change_direction, which may also move it
+    // along the line: its end on the programmed line moves by that much, and the room it may
+    // take is measured from there (the cuts again, with the same d).
+    const LaneChange lc1 = lane_change_direction(t1, n1), lc2 = lane_change_direction(t2, n2);
+    const AxisArray &w1 = lc1.w, &w2 = lc2.w;
+    const double along1 = d * lc1.along, along2 = d * lc2.along;
+    if ((along1 != 0 || along2 != 0) &&
+        !offset_cuts(lp, kOffsetShare, tol, sin_angle, cos_t, sin_t, f, room1 - along1,
+                     room2 + along2, cuts))
+        return false;
+    const double ls1 = cuts.ls1 + along1, ls2 = cuts.ls2 - along2;
+    const double cut_before_mm = cuts.before_mm + along1, cut_after_mm = cuts.after_mm - along2;
+    if (!(ls1 > 0 && ls2 > 0)) return false;
     // The offset corner c2 is d from both lines, outwards; a0 and b3 lie on the programmed lines.
     AxisArray c2, a0, a3, b0, b3;
     for (int k = 0; k < kAxes; ++k) {
         c2[k] = c[k] + d * (t1[k] - t2[k]) / sin_t;
         a3[k] = c2[k] - lp * t1[k];
-        a0[k] = a3[k] - ls1 * t1[k] - d * n1[k];
+        a0[k] = a3[k] - cuts.ls1 * t1[k] - d * w1[k];
         b0[k] = c2[k] + lp * t2[k];
-        b3[k] = b0[k] + ls2 * t2[k] - d * n2[k];
+        b3[k] = b0[k] + cuts.ls2 * t2[k] - d * w2[k];
     }
     // Every piece is proved within the tolerance of the programmed lines. In the axes neither
     // line moves, all their points equal the corner's (the terms added to it there are +-0), so
@@ -572,8 +634,10 @@ bool Planner::offset_corner(const Piece& p, const Piece& next, const OffsetFrame
     const CornerPath path = corner_path(p.geom, cut_before_mm, next.geom, cut_after_mm, tol);
     const double limit = kOffsetProofShare * tol;
     BezierPoints out, par, in;
-    if (!shift_bezier_within(a0, t1, a3, t1, ls1 / 2, path, limit, out) ||
-        !shift_bezier_within(b0, t2, b3, t2, ls2 / 2, path, limit, in))
+    // The lane changes' control legs are those of a shift of length ls along the normal (with
+    // the legs of the corrected length tp_default took 2 ms longer).
+    if (!shift_bezier_within(a0, t1, a3, t1, cuts.ls1 / 2, path, limit, out) ||
+        !shift_bezier_within(b0, t2, b3, t2, cuts.ls2 / 2, path, limit, in))
         return false;
     for (int k = 0; k < kAxes; ++k) {
         par.p0[k] = c2[k] - lp * t1[k];

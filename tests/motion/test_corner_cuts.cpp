@@ -1,7 +1,9 @@
-// How long the planner cuts a corner between a rapid (or a faster move) and a slow feed move,
-// without a jerk limit: the turn runs at the slower feed whatever its cut, so any cut longer
-// than that speed needs only slows the turn. Answers worked out by hand from the parabola's
-// constant second derivative (t2 - t1) / 2l (docs/motion-planner.md, "Geometry").
+// How the planner cuts corners without a jerk limit, answers worked out by hand from the
+// parabola's constant second derivative (t2 - t1) / 2l (docs/motion-planner.md, "Geometry"):
+// a corner between a rapid (or a faster move) and a slow feed move, whose turn runs at the
+// slower feed whatever its cut, so any cut longer than that speed needs only slows the turn;
+// and a row end's corner onto a short sloped step, cut on offset lines with lane changes along
+// one axis.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -123,6 +125,43 @@ TEST(CornerCuts, ANonIsolatedParabolaAfterARapidIsCutForItsOwnShare) {
     EXPECT_NEAR(recs[1].geom.length_mm, 2 * l, 1e-12);
     EXPECT_NEAR(recs[0].geom.length_mm, 10 - l, 1e-12);
     EXPECT_NEAR(recs[1].profile.peak_v_mm_s, 4, 1e-9);
+    expect_within_path_and_limits(cfg, prog, recs);
+}
+
+// tp_default's X0 row end, second corner: the 5 mm Y step (+Y) onto a 0.5 mm step along
+// (0.5, 0.1) (79 degrees), then the row goes on along the same direction. The short step used to
+// leave no room for the lane change back (half of it, 0.255 mm, below the 2/3 x 0.41 mm the
+// offset corner needs), so the corner was cut one-sided at 10.84 mm/s. A line of at most 1 mm
+// now gives 0.9 of itself, so the offset corner fits: the turn is the parabola between the two
+// lines moved d = 0.99 tol outwards, cut lp = 2 x 0.99 tol / (sin(angle) / 4) = 0.08073 mm
+// (sin(angle) = 0.98058), passed at sqrt(0.99 x 990 x 2 lp / |dT_x|) = 12.71 mm/s (|dT_x| =
+// 0.98058 is the larger of |dT_x|, |dT_y| = 0.80388). The lane change back onto the sloped step
+// moves the tool along Y only (its outward normal lies 0.98 along Y), so X runs on as along the
+// line: its second derivative is only what the Bezier's parametrisation gives (a few % of Y's),
+// where a shift along the normal (-0.196, 0.981) would give X 0.2 of Y's.
+TEST(CornerCuts, RowEndOntoAShortSlopedStepIsCutOnOffsetLinesShiftingAlongOneAxis) {
+    const PlannerConfig cfg = machine();
+    test::Program prog;
+    prog.segs = {move({0, 10}, 50, 0), move({0.5, 10.1}, 50, 1), move({10.5, 12.1}, 50, 2)};
+    const auto recs = plan(cfg, prog);
+    const double s = 1 / std::sqrt(1.04), sin_angle = std::sqrt(1 - s * s * 0.04);
+    EXPECT_NEAR(sin_angle, 0.98058, 1e-5);
+    const double lp = 2 * 0.99 * kTol / (sin_angle / 4);
+    const double v = std::sqrt(0.99 * kUsable * 2 * lp / s);  // |dT_x| = s = 0.98058
+    EXPECT_NEAR(v, 12.71, 0.01);
+    std::vector<const PreparedSegment*> beziers;
+    for (const PreparedSegment& r : recs)
+        if (r.geom.kind == ElementKind::Bezier) beziers.push_back(&r);
+    // Shift out (on the Y step's line), the turn and the shift back (the next move's).
+    ASSERT_EQ(beziers.size(), 3u);
+    EXPECT_EQ(beziers[0]->line, 0);
+    EXPECT_EQ(beziers[1]->line, 1);
+    EXPECT_EQ(beziers[2]->line, 1);
+    EXPECT_NEAR(beziers[1]->geom.length_mm, 2 * lp, 1e-12);
+    EXPECT_NEAR(beziers[1]->profile.peak_v_mm_s, v, 1e-6);
+    const ElementBounds back = bounds(beziers[2]->geom);
+    EXPECT_GT(back.g2[1], 0);
+    EXPECT_LT(back.g2[0], 0.05 * back.g2[1]);
     expect_within_path_and_limits(cfg, prog, recs);
 }
 

@@ -220,9 +220,11 @@ TEST(Planner, BlendsInAChainOfShortMovesKeepAShareForSpeedChanges) {
     EXPECT_NEAR(recs[recs.size() / 2].profile.peak_v_mm_s, v, 1e-9);
 }
 
-// A right angle from a long line onto a 0.5 mm one (which continues straight on): the short
+// A right angle from a long line onto a 0.25 mm one (which continues straight on): the short
 // line has no room for the lane change back (offset_corner needs >= 0.27 mm of it beyond the
-// turn), so only the long line is moved outwards, by d = 0.99 tol (one_sided_offset_corner).
+// turn; a line of at most 1 mm gives it 0.9 of itself, 0.225 mm here; with 0.5 mm, as this test
+// had until 2026-11-22, it now gets the offset corner), so only the long line is moved
+// outwards, by d = 0.99 tol (one_sided_offset_corner).
 // Turning from +X onto +Y at (10, 0), the offset line y = -d meets x = 10 at c2 = (10, -d), and
 // the parabola runs from (10 - lp, -d) to (10, lp - d): its distance from the lines is
 // min(u^2 lp - d, lp (1 - u)^2), largest where the two are equal, (lp - d)^2 / (4 lp). That is
@@ -232,8 +234,8 @@ TEST(Planner, BlendsInAChainOfShortMovesKeepAShareForSpeedChanges) {
 TEST(Planner, RightAngleOntoAShortLineIsCutOnTheLongLineMovedOutwards) {
     PlannerConfig cfg = uniform(100, 1000, 0);
     const double tol = 0.01;
-    auto recs = plan(cfg, {line_to({10}, 50, tol, 0), line_to({10, 0.5}, 50, tol, 1),
-                           line_to({10, 10.5}, 50, tol, 2)});
+    auto recs = plan(cfg, {line_to({10}, 50, tol, 0), line_to({10, 0.25}, 50, tol, 1),
+                           line_to({10, 10.25}, 50, tol, 2)});
     ASSERT_EQ(recs.size(), 5u);
     const double d = 0.99 * tol;
     const double limit = 0.995 * tol;
@@ -251,7 +253,7 @@ TEST(Planner, RightAngleOntoAShortLineIsCutOnTheLongLineMovedOutwards) {
     EXPECT_EQ(recs[2].line, 1);
     EXPECT_NEAR(recs[0].geom.length_mm, 10 - lp - ls, 1e-12);
     EXPECT_NEAR(recs[2].geom.length_mm, 2 * lp, 1e-12);
-    EXPECT_NEAR(recs[3].geom.length_mm, 0.5 - (lp - d), 1e-12);
+    EXPECT_NEAR(recs[3].geom.length_mm, 0.25 - (lp - d), 1e-12);
     EXPECT_NEAR(recs[4].geom.length_mm, 10, 1e-12);
     // The turn runs at sqrt(0.99 x 990 x 2 lp) = 10.627 mm/s, 1.2 x the 8.855 mm/s of the
     // parabola inside the corner.
