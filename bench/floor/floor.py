@@ -926,12 +926,11 @@ def parse_cbc(text, returncode, cpu_s):
     objective = number("Objective value")
     found = objective is not None and "no feasible" not in low
     if low.startswith("optimal solution found"):
-        return SolverAnswer(False, True, True, objective, objective, 0.0, cpu_s)
+        return SolverAnswer(False, True, True, objective, objective, 0.0, cpu_s)  # proved optimal
     if low.startswith("stopped"):
-        bound = number("Lower bound")
-        gap = number("Gap")
-        return SolverAnswer(False, found, False, objective if found else math.nan, bound,
-                            math.nan if gap is None else gap, cpu_s)
+        # A stopped solve proves nothing here (its bound is not read: --single is HiGHS only).
+        return SolverAnswer(False, found, False, objective if found else math.nan, None,
+                            math.nan, cpu_s)
     raise RuntimeError(f"cbc: unexpected result '{result}'")
 
 
@@ -1058,6 +1057,9 @@ def section_floor(moves, a, b, v_mm_s=100.0, a_mm_s2=1000.0, step_ms=1.0, lead_i
         horizon_s = model(None).U * h
 
     if not search:
+        if solver != "highs":
+            # CBC's dual bound on a stopped solve is not read reliably yet: feasibility only.
+            raise ProgramError("--single needs --solver highs")
         return model(horizon_s).solve(time_limit_s, verbose)
     top = model(horizon_s)
     # The corner regions' gaps alone: t_b - t_a >= min_time(a, b).
