@@ -25,25 +25,26 @@ constexpr int kMaxDepth = 40;
 constexpr double kRounding = 1e-9;
 constexpr int kFirstRotary = 3, kLastRotary = 5;  // A, B, C
 // Joint rates (see "Joint rates at plan time" in the header).
-constexpr double kRateStep = 1e-3;       // mm or degrees along the tangent and curvature
+constexpr double kRateStep = 1e-2;       // mm or degrees along the tangent
 constexpr double kRateTolerance = 1e-3;  // allowance 2 |d| within this share of the bound
 constexpr double kRateFloor = 1e-6;      // ... or below this (joint units per mm, per mm^2)
 constexpr int kMaxRateDepth = 10;        // halvings of a piece
 constexpr double kSlowestCapMmS = 1e-6;  // the planner needs a speed > 0
 
 // The largest |f| on an interval from f at its ends and middle (the parabola allowance), and
-// whether the allowance is small against it.
+// whether the allowance is small against it or against `scale`, the largest |f| at the move's
+// piece ends (a joint's rate where it is far below its own peak decides no cap).
 struct RateBound {
     double bound;
     bool fine;
 };
-RateBound rate_bound(double f0, double fm, double f1) noexcept {
+RateBound rate_bound(double f0, double fm, double f1, double scale) noexcept {
     const double d = std::fabs(fm - 0.5 * (f0 + f1));
     const double hi = std::max({f0, fm, f1}) + kCurvatureFactor * d;
     const double lo = std::min({f0, fm, f1}) - kCurvatureFactor * d;
     const double bound = std::max(std::fabs(hi), std::fabs(lo));
     // NaN (a point the kinematics cannot reach) is never fine: halved to the depth limit.
-    return {bound, kCurvatureFactor * d <= kRateTolerance * bound + kRateFloor};
+    return {bound, kCurvatureFactor * d <= kRateTolerance * std::max(bound, scale) + kRateFloor};
 }
 
 int piece_count(const motion::Element& e, const motion::AxisArray& start) {
@@ -234,7 +235,7 @@ void JointLimitCheck::rates_at(const motion::Element& e, double s_mm, Rates& out
 }
 
 void JointLimitCheck::bound_rates(const motion::Element& e, double s0, const Rates& r0, double s1,
-                                  const Rates& r1, int depth, Joints& g_max,
+                                  const Rates& r1, int depth, const Rates& scale, Joints& g_max,
                                   Joints& h_max) const noexcept {
     const double sm = 0.5 * (s0 + s1);
     Rates rm;
@@ -242,8 +243,8 @@ void JointLimitCheck::bound_rates(const motion::Element& e, double s0, const Rat
     Joints g, h;
     bool fine = true;
     for (std::size_t n = 0; n < joints_; ++n) {
-        const RateBound bg = rate_bound(r0.g[n], rm.g[n], r1.g[n]);
-        const RateBound bh = rate_bound(r0.h[n], rm.h[n], r1.h[n]);
+        const RateBound bg = rate_bound(r0.g[n], rm.g[n], r1.g[n], scale.g[n]);
+        const RateBound bh = rate_bound(r0.h[n], rm.h[n], r1.h[n], scale.h[n]);
         g[n] = bg.bound;
         h[n] = bh.bound;
         fine = fine && bg.fine && (cfg_.max_acceleration[n] <= 0 || bh.fine);
@@ -256,8 +257,8 @@ void JointLimitCheck::bound_rates(const motion::Element& e, double s0, const Rat
         }
         return;
     }
-    bound_rates(e, s0, r0, sm, rm, depth + 1, g_max, h_max);
-    bound_rates(e, sm, rm, s1, r1, depth + 1, g_max, h_max);
+    bound_rates(e, s0, r0, sm, rm, depth + 1, scale, g_max, h_max);
+    bound_rates(e, sm, rm, s1, r1, depth + 1, scale, g_max, h_max);
 }
 
 double JointLimitCheck::speed_cap_mm_s(const motion::Element& e,
@@ -265,13 +266,22 @@ double JointLimitCheck::speed_cap_mm_s(const motion::Element& e,
     if (!cfg_.kins || cfg_.max_velocity.size() != joints_ || !(e.length_mm > 0)) return INFINITY;
     Joints g_max{}, h_max{};
     const int pieces = piece_count(e, motion::point_at(e, 0));
-    Rates r0, r1;
+    auto piece_end = [&](int i) { return i == pieces ? e.length_mm : e.length_mm * i / pieces; };
+    // First the scale: each joint's largest |g| and |h| at the piece ends.
+    Rates r0, r1, scale{};
+    for (int i = 0; i <= pieces; ++i) {
+        rates_at(e, piece_end(i), r1);
+        for (std::size_t n = 0; n < joints_; ++n) {
+            scale.g[n] = std::max(scale.g[n], std::fabs(r1.g[n]));
+            scale.h[n] = std::max(scale.h[n], std::fabs(r1.h[n]));
+        }
+    }
     rates_at(e, 0, r0);
     double s0 = 0;
     for (int i = 1; i <= pieces; ++i) {
-        const double s1 = i == pieces ? e.length_mm : e.length_mm * i / pieces;
+        const double s1 = piece_end(i);
         rates_at(e, s1, r1);
-        bound_rates(e, s0, r0, s1, r1, 0, g_max, h_max);
+        bound_rates(e, s0, r0, s1, r1, 0, scale, g_max, h_max);
         s0 = s1;
         r0 = r1;
     }

@@ -27,32 +27,33 @@
 // A machine standing outside a joint limit (after a reset) may move back in, as for the axis
 // limits: points on the way may be as far out as the start, the end must be inside.
 //
-// Joint rates at plan time (speed_cap_mm_s). Under a kinematics the planner has no joint map of
-// (a tilting table's joints depend on the angles) the planner limits the axes only. A joint
-// moves at dq/dt = g(s) v, g = dq/ds = J p', v = ds/dt the path speed (s the planner's path
-// length: rotary degrees count as mm), and accelerates at g dv/dt + (J p'' + h) v^2, where
-// h = D2q[p', p'] is the curvature the kinematics adds to the path's own (a C rotation turns a
-// straight line in C into a circle of the motors X and Y). So the move's speed is capped at
-// min over joints of max_velocity / max|g| (a feed is lowered to it, a rapid gets it as its
-// rapid rate) and at sqrt(kCurvatureAccShare max_acceleration / max|h|), both divided by the
-// override the sampler may apply on top (max_rate), unless the axes' own velocity limits keep
-// the path slower than that anyway (the sampler's rate caps keep the axes within them at any
-// override, so a joint that mirrors an axis costs no speed). g and h come from central differences
-// of the inverse kinematics along the path's tangent (a 1e-3 mm or degree step: truncation about
-// 1e-6 |q'''|, rounding about 1e-10) at the ends and middle of the same pieces as the soft
-// limit check (90 degrees of arc, 10 degrees of rotary travel); on such a piece g and h are as
-// close to parabolas as the joints are, so the same allowance bounds them: max |g| <= the
-// largest sample + 2 |d|, d the midpoint deviation. A piece is halved (at most 10 times) until
-// 2 |d| is within 0.1 % of its bound (+1e-6): the cap is then at most about 0.1 % below the
-// exact one. A cap within that 0.1 % of the speed the axes allow is not applied (a joint that
-// mirrors an axis along a curve would otherwise slow the move by the allowance): such a joint
-// may reach 1.001 times its max_velocity, the servo check's slack.
-// Not covered, left to the servo function's check (reported at stop): the acceleration terms
-// g dv/dt and J p'' v^2, which the planner keeps within the axes' limits, not the joints' (on a
-// tilted table an axis's acceleration lands partly on another motor), and the share of h the
-// axes take too; corner blends, which are not sampled (a blend's tangent lies between the two
-// moves' tangents at a point within the tolerance of the corner, and it runs no faster than
-// the slower move, so its joint speeds are the moves' there to within the tolerance).
+// Joint rates at plan time (speed_cap_mm_s). Under a kinematics the planner has no joint map of (a
+// tilting table's joints depend on the angles) the planner limits the axes only. A joint moves at
+// dq/dt = g(s) v, g = dq/ds = J p', v = ds/dt the path speed (s the planner's path length: rotary
+// degrees count as mm), and accelerates at g dv/dt + (J p'' + h) v^2, where h = D2q[p', p'] is the
+// curvature the kinematics adds to the path's own (a C rotation turns a straight line in C into a
+// circle of the motors X and Y). So the move's speed is capped at min over joints of max_velocity /
+// max|g| (a feed is lowered to it, a rapid gets it as its rapid rate) and at
+// sqrt(kCurvatureAccShare max_acceleration / max|h|), both divided by the override the sampler may
+// apply on top (max_rate), unless the axes' own velocity limits keep the path slower than that
+// anyway (the sampler's rate caps keep the axes within them at any override, so a joint that
+// mirrors an axis costs no speed). g and h come from central differences of the inverse kinematics
+// along the path's tangent (a 1e-2 mm or degree step: truncation about 2e-5 |q'''| in g, rounding
+// about 1e-9 in h; a step of 1e-3 left h too noisy to stop halving) at the ends and middle of the
+// same pieces as the soft limit check (90 degrees of arc, 10 degrees of rotary travel); on such a
+// piece g and h are as close to parabolas as the joints are, so the same allowance bounds them: max
+// |g| <= the largest sample + 2 |d|, d the midpoint deviation. A piece is halved (at most 10 times)
+// until 2 |d| is within 0.1 % of its bound, or of the joint's largest rate at the piece ends
+// (+1e-6): the cap is then at most about 0.1 % below the exact one. A cap within that 0.1 % of the
+// speed the axes allow is not applied (a joint that mirrors an axis along a curve would otherwise
+// slow the move by the allowance): such a joint may reach 1.001 times its max_velocity, the servo
+// check's slack. Not covered, left to the servo function's check (reported at stop): the
+// acceleration terms g dv/dt and J p'' v^2, which the planner keeps within the axes' limits, not
+// the joints' (on a tilted table an axis's acceleration lands partly on another motor), so the half
+// of max_acceleration h leaves is not a guarantee for them; corner blends, which are not sampled (a
+// blend's tangent lies between the two moves' tangents at a point within the tolerance of the
+// corner, and it runs no faster than the slower move, so its joint speeds are the moves' there to
+// within the tolerance).
 #pragma once
 
 #include <array>
@@ -135,7 +136,8 @@ class JointLimitCheck {
     };
     void rates_at(const motion::Element& e, double s_mm, Rates& out) const noexcept;
     void bound_rates(const motion::Element& e, double s0, const Rates& r0, double s1,
-                     const Rates& r1, int depth, Joints& g_max, Joints& h_max) const noexcept;
+                     const Rates& r1, int depth, const Rates& scale, Joints& g_max,
+                     Joints& h_max) const noexcept;
     struct Farthest {
         double s_mm, excess;
     };
