@@ -22,7 +22,7 @@ import time
 sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from check import Failure, check_run  # noqa: E402
+from check import TRT_EXCESS, Failure, check_run  # noqa: E402
 from machine import read_machine  # noqa: E402
 from program import ProgramError, generate, model_of  # noqa: E402
 
@@ -99,6 +99,15 @@ def shrink(cnc, machine, lines, failure, workdir, timeout_s, budget_s):
     return best
 
 
+def excess_reported(workdir):
+    """Whether motion reported joint velocity/acceleration excesses (tolerated on 5axis-trt)."""
+    try:
+        with open(os.path.join(workdir, "stderr.txt"), encoding="utf-8") as f:
+            return any(TRT_EXCESS.match(line) for line in f)
+    except OSError:
+        return False
+
+
 def soak_one(args, config, seed):
     machine = read_machine(os.path.join(ROOT, "configs", "sim", config + ".ini"))
     lines = generate(machine, seed, args.steps, args.arc_end_off)
@@ -107,8 +116,9 @@ def soak_one(args, config, seed):
         t0 = time.monotonic()
         failure, model = run_program(args.cnc, machine, lines, work, args.run_timeout)
         elapsed = time.monotonic() - t0
+        noted = excess_reported(work)
         if failure is None and not args.keep:
-            return config, seed, None, elapsed, None
+            return config, seed, None, elapsed, noted
         out = os.path.join(args.out, f"{config}-s{seed}")
         shutil.rmtree(out, ignore_errors=True)
         os.makedirs(out)
@@ -116,7 +126,7 @@ def soak_one(args, config, seed):
             if os.path.exists(os.path.join(work, name)):
                 shutil.copy(os.path.join(work, name), out)
         if failure is None:
-            return config, seed, None, elapsed, out
+            return config, seed, None, elapsed, noted
         prog = os.path.join(out, "prog.ngc")
         text = f"{failure.check}: {failure.where(prog)}: {failure.detail}"
         if not args.no_shrink:
@@ -129,7 +139,7 @@ def soak_one(args, config, seed):
                         f"{f2.where(os.path.join(out, 'shrunk.ngc'))}: {f2.detail}"
         with open(os.path.join(out, "failure.txt"), "w") as f:
             f.write(f"config {config} seed {seed}\n{text}\n")
-        return config, seed, text, elapsed, out
+        return config, seed, text, elapsed, noted
     finally:
         shutil.rmtree(work, ignore_errors=True)
 
@@ -166,9 +176,12 @@ def main():
     args.out = os.path.abspath(args.out)
     t0 = time.monotonic()
     failures = 0
+    noted = []
     jobs = [(c, s) for s in seeds for c in configs]
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        for config, seed, text, elapsed, _ in pool.map(lambda cs: soak_one(args, *cs), jobs):
+        for config, seed, text, elapsed, excess in pool.map(lambda cs: soak_one(args, *cs), jobs):
+            if excess:
+                noted.append(f"{config}/{seed}")
             if text:
                 failures += 1
                 print(f"FAIL {config} seed {seed}: {text}", flush=True)
@@ -176,6 +189,9 @@ def main():
                 print(f"ok   {config} seed {seed} ({elapsed:.2f} s)", flush=True)
     print(f"soak: {len(jobs)} runs ({len(seeds)} seeds x {len(configs)} configs), {failures} failed, "
           f"{time.monotonic() - t0:.0f} s")
+    if noted:
+        print(f"soak: motion reported joint velocity/acceleration excesses (tolerated on 5axis-trt) in "
+              f"{len(noted)} runs: {' '.join(noted[:20])}{' ...' if len(noted) > 20 else ''}")
     return 1 if failures else 0
 
 
