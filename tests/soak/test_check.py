@@ -12,7 +12,7 @@ sys.dont_write_bytecode = True  # no __pycache__ in the source tree
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import check  # noqa: E402
-from machine import AxisLimits, JointLimits, Machine  # noqa: E402
+from machine import AxisLimits, JointLimits, Machine, read_machine  # noqa: E402
 from program import Model, generate, model_of  # noqa: E402
 
 T = 1e-3
@@ -300,6 +300,27 @@ class ModelGeometry(unittest.TestCase):
         self.assertEqual(ends[:4], [[10, 0, 0], [10, 0, -5], [10, 0, -1], [20, 0, -1]])
         self.assertEqual([e.tol_end_mm for e in model.elements[4:]], [0.2, 0.0, 0.0])
         self.assertEqual(model.elements[0].tol_end_mm, 0.01)
+
+    def test_programs_stay_inside_every_sim_config(self):
+        """Every point the generator programs (arcs: their whole circle) lies within the soft
+        limits of each configs/sim machine (the start, machine zero, is on mill's Z limit), and
+        each program ends with M30 or M2."""
+        root = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "configs", "sim")
+        for name in ("mill", "mill-servo", "gantry", "corexy", "5axis-trt"):
+            m = read_machine(os.path.join(root, name + ".ini"))
+            for seed in range(1, 16):
+                model = model_of(generate(m, seed, 30), m)
+                self.assertTrue(model.ended, (name, seed))
+                for e in model.elements:
+                    lo = list(e.end)
+                    hi = list(e.end)
+                    if e.arc:
+                        u, v, cu, cv, r0, _, _, r1 = e.arc
+                        r = max(r0, r1)
+                        lo[u], hi[u], lo[v], hi[v] = cu - r, cu + r, cv - r, cv + r
+                    for k, l in enumerate(m.letters):
+                        a = m.axes[l]
+                        self.assertTrue(a.min_mm <= lo[k] and hi[k] <= a.max_mm, (name, seed, e.line, l))
 
     def test_generated_programs_are_valid_for_the_model(self):
         for seed in range(1, 30):
