@@ -302,7 +302,11 @@ def _pick(els, cum, indices, q, s_last, s_max, axes):
     if not cands:
         return None
     best = min(cands)
-    near = [c for c in cands if c[0] <= best[0] + QUANTUM]
+    # Among the points the sample is within the allowance of (or, if none, those as near as
+    # the nearest), the one not going back and nearest the last sample's. Not simply the least
+    # excess: a move with a generous tolerance at one corner (P0.5) would take the samples of a
+    # move that reverses onto it (P0.01) back along itself.
+    near = [c for c in cands if c[0] <= max(0.0, best[0] + QUANTUM)]
     _, _, s, i = min(near, key=lambda c: (c[2] < s_max - GOING_BACK_MM, abs(c[2] - s_last)))
     return best[0], best[1], s, i, best[3]
 

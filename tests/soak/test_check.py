@@ -94,6 +94,17 @@ class PathCheck(unittest.TestCase):
         pts = smooth_move([0, 0, 0], [0, 0, -20], 1.0) + smooth_move([0, 0, -20], [0, 0, -5], 1.0)
         self.assertIsNone(check.check_path(trace_of(pts, [1] * 1005 + [2] * 1005), model))
 
+    def test_a_reversal_after_a_generous_corner(self):
+        """soak 5axis-trt seed 132: a move whose start corner has P0.5 and a move reversing onto
+        it at P0.01; on the way back the samples are within 0.5 of the first and on the second,
+        and must be taken on the second (the least excess took them back along the first until
+        the window left it)."""
+        model = model_of(["G64 P0.5", "G0 Y5", "G64 P0.01", "G0 Z-5", "G0 Y5.01 Z-1", "M30"], self.m)
+        pts = (smooth_move([0, 0, 0], [0, 5, 0], 1.0) + smooth_move([0, 5, 0], [0, 5, -5], 1.0)
+               + smooth_move([0, 5, -5], [0, 5.01, -1], 1.0))
+        lines = [2] * 1005 + [4] * 1005 + [5] * 1005
+        self.assertIsNone(check.check_path(trace_of(pts, lines), model))
+
     def test_running_the_path_backwards_fails(self):
         f = check.check_path(trace_of(list(reversed(self.pts))), self.model)
         self.assertIsNotNone(f)
