@@ -256,10 +256,6 @@ def distance(e, q):
 # more than BACK_MM, or skips ahead, is measured from the wrong part of it and fails.
 BACK_MM = 3.0
 AHEAD_MM = 2.0
-# Where a sample projects onto the path wobbles back a little near corners (by about the blend
-# tolerance); when ties are broken, only a point more than this behind the farthest point reached
-# counts as going back (a path that reverses onto itself: the later pass).
-GOING_BACK_MM = 0.05
 
 
 def _tolerance(els, i):
@@ -279,13 +275,13 @@ def _allowed(els, i, axes):
             + ARITHMETIC_MM)
 
 
-def _pick(els, cum, indices, q, s_last, s_max, axes):
+def _pick(els, cum, indices, q, s_max, axes):
     """(excess, distance, path position s, element, element of the least excess) of the point of
     the path within the window about s_max that the sample is nearest to relative to its
     allowance (excess = distance - allowed there: a sample near two elements needs to be within
     the tolerance of one of them); None if every element lies outside the window. A nearest
-    point outside the window is replaced by the window's end on that element. Ties (within the
-    trace's resolution) go to the point that does not go back from s_max and is nearest s_last."""
+    point outside the window is replaced by the window's end on that element. Of the points the
+    sample is within the allowance of, the farthest along the path is taken."""
     cands = []
     for i in indices:
         e = els[i]
@@ -302,12 +298,15 @@ def _pick(els, cum, indices, q, s_last, s_max, axes):
     if not cands:
         return None
     best = min(cands)
-    # Among the points the sample is within the allowance of (or, if none, those as near as
-    # the nearest), the one not going back and nearest the last sample's. Not simply the least
-    # excess: a move with a generous tolerance at one corner (P0.5) would take the samples of a
-    # move that reverses onto it (P0.01) back along itself.
-    near = [c for c in cands if c[0] <= max(0.0, best[0] + QUANTUM)]
-    _, _, s, i = min(near, key=lambda c: (c[2] < s_max - GOING_BACK_MM, abs(c[2] - s_last)))
+    if best[0] > 0:
+        return best[0], best[1], best[2], best[3], best[3]
+    # Among the points the sample is within the allowance of, the farthest along the path: a
+    # generous tolerance lets the tool cut through short moves (P0.5 across a 0.5 mm move), and
+    # taking the nearest or the least excess there kept the match on a move behind the tool until
+    # the window left the tool (a move reversing onto one with P0.5 at a corner, a blend through
+    # short moves into an arc).
+    within = [c for c in cands if c[0] <= 0]
+    _, _, s, i = max(within, key=lambda c: c[2])
     return best[0], best[1], s, i, best[3]
 
 
@@ -327,16 +326,16 @@ def check_path(tr, model):
     cum = [0.0]
     for e in els:
         cum.append(cum[-1] + e.length_mm)
-    cur, s_last, s_max = 0, 0.0, 0.0
+    cur, s_max = 0, 0.0
     axes = len(els[0].start)
     for n, q in enumerate(tr.axes):
-        pick = _pick(els, cum, [k for k in (cur, cur + 1) if k < len(els)], q, s_last, s_max, axes)
+        pick = _pick(els, cum, [k for k in (cur, cur + 1) if k < len(els)], q, s_max, axes)
         if pick is None or pick[0] > 0:
             lo = max(0, bisect.bisect_left(cum, s_max - BACK_MM) - 1)
             hi = min(len(els), bisect.bisect_right(cum, s_max + AHEAD_MM) + 1)
-            pick = _pick(els, cum, range(lo, hi), q, s_last, s_max, axes)
+            pick = _pick(els, cum, range(lo, hi), q, s_max, axes)
         excess, d, s, i, nearest = pick
-        cur, s_last, s_max = i, s, max(s_max, s)
+        cur, s_max = i, max(s_max, s)
         if excess > 0:
             i = nearest
             return Failure("path", f"{d:.6f} mm from the programmed path (tolerance {_tolerance(els, i)} mm) "

@@ -168,10 +168,10 @@ class PathCheck(unittest.TestCase):
         for e in els:
             cum.append(cum[-1] + e.length_mm)
         at_corner = [10.0, 0.0, 0.0]
-        self.assertIsNone(check._pick(els, cum, [2], at_corner, 10.0, 10.0, 3))
+        self.assertIsNone(check._pick(els, cum, [2], at_corner, 10.0, 3))
         # The circle's start, not its end (31 mm ahead), though the sample projects a hair
         # behind where the last one did.
-        _, d, s, i, _ = check._pick(els, cum, [0, 1, 2], at_corner, 10.001, 10.001, 3)
+        _, d, s, i, _ = check._pick(els, cum, [0, 1, 2], at_corner, 10.001, 3)
         self.assertEqual(i, 1)
         self.assertAlmostEqual(s, 10.0, places=6)
 
