@@ -105,6 +105,17 @@ class PathCheck(unittest.TestCase):
         lines = [2] * 1005 + [4] * 1005 + [5] * 1005
         self.assertIsNone(check.check_path(trace_of(pts, lines), model))
 
+    def test_cutting_through_short_moves(self):
+        """soak seed 101: at P0.5 the tool cut through short moves (here 25 moves of 0.1 mm back
+        and forth, 2.5 mm of path in one place) into a long one; the match stayed at the end of
+        the move before them, still within 0.5 mm, until the long move left the 2 mm window."""
+        prog = ["G64 P0.5 F600", "G1 X10"] + [f"G1 X{10.1 if k % 2 == 0 else 10}" for k in range(25)]
+        model = model_of(prog + ["G1 Y5", "M30"], self.m)
+        pts = (smooth_move([0, 0, 0], [10, 0, 0], 1.0) + smooth_move([10, 0, 0], [10.1, 0, 0], 0.05)
+               + smooth_move([10.1, 0, 0], [10.1, 5, 0], 1.0))
+        lines = [2] * 1005 + [3 + 24 * k // 55 for k in range(55)] + [28] * 1005
+        self.assertIsNone(check.check_path(trace_of(pts, lines), model))
+
     def test_running_the_path_backwards_fails(self):
         f = check.check_path(trace_of(list(reversed(self.pts))), self.model)
         self.assertIsNotNone(f)
