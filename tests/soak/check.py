@@ -280,8 +280,8 @@ def _pick(els, cum, indices, q, s_max, axes):
     the path within the window about s_max that the sample is nearest to relative to its
     allowance (excess = distance - allowed there: a sample near two elements needs to be within
     the tolerance of one of them); None if every element lies outside the window. A nearest
-    point outside the window is replaced by the window's end on that element. Of the points the
-    sample is within the allowance of, the farthest along the path is taken."""
+    point outside the window is replaced by the window's end on that element. The sample passes
+    when the least excess is <= 0; the path position is the nearest point's."""
     cands = []
     for i in indices:
         e = els[i]
@@ -298,22 +298,18 @@ def _pick(els, cum, indices, q, s_max, axes):
     if not cands:
         return None
     best = min(cands)
-    if best[0] > 0:
-        return best[0], best[1], best[2], best[3], best[3]
-    # Among the points the sample is within the allowance of, the farthest along the path: a
-    # generous tolerance lets the tool cut through short moves (P0.5 across a 0.5 mm move), and
-    # taking the nearest or the least excess there kept the match on a move behind the tool until
-    # the window left the tool (a move reversing onto one with P0.5 at a corner, a blend through
-    # short moves into an arc).
-    within = [c for c in cands if c[0] <= 0]
-    _, _, s, i = max(within, key=lambda c: c[2])
+    # Where the tool is on the path: the nearest point (ties, within the trace's resolution, to
+    # the farthest along: a move reversing onto the one before). Not the farthest of the points
+    # within their allowance: that ratchets ahead of the tool by up to the window each sample.
+    dmin = min(c[1] for c in cands)
+    _, _, s, i = max((c for c in cands if c[1] <= dmin + QUANTUM), key=lambda c: c[2])
     return best[0], best[1], s, i, best[3]
 
 
 def _lines_near(els, cum, s):
     """The program lines a sample at path position s may be tagged with: those of the elements
-    within BACK_MM behind and AHEAD_MM ahead (and the lines between them that do not move: modes,
-    dwells, the end), so a line number from elsewhere in the program fails."""
+    within BACK_MM behind and AHEAD_MM ahead, and the lines between them that do not move
+    (modes, dwells, the end), so a line number from elsewhere in the program fails."""
     lo = max(0, bisect.bisect_left(cum, s - BACK_MM) - 1)
     hi = min(len(els) - 1, bisect.bisect_right(cum, s + AHEAD_MM))
     return (els[lo].line if lo > 0 else 0, els[hi].line if hi < len(els) - 1 else math.inf)

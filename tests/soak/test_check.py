@@ -116,6 +116,21 @@ class PathCheck(unittest.TestCase):
         lines = [2] * 1005 + [3 + 24 * k // 55 for k in range(55)] + [28] * 1005
         self.assertIsNone(check.check_path(trace_of(pts, lines), model))
 
+    def test_moves_back_and_forth_within_the_tolerance(self):
+        """soak seed 27: moves of 1 mm back and forth 0.01 mm apart at P0.1; taking the farthest
+        point within the allowance ran the match ahead of the tool, 2 mm a sample."""
+        model = model_of(["G64 P0.1 F600", "G1 X10", "G1 X9", "G1 X10 Y0.01", "G1 X9 Y0.02",
+                          "G1 X10 Y0.03", "G1 X9 Y0.04", "M30"], self.m)
+        pts = smooth_move([0, 0, 0], [10, 0, 0], 1.0)
+        lines = [2] * len(pts)
+        here = [10, 0, 0]
+        for k, e in enumerate(model.elements[1:]):
+            part = smooth_move(here, e.end, 0.3)
+            pts += part
+            lines += [3 + k] * len(part)
+            here = e.end
+        self.assertIsNone(check.check_path(trace_of(pts, lines), model))
+
     def test_running_the_path_backwards_fails(self):
         f = check.check_path(trace_of(list(reversed(self.pts))), self.model)
         self.assertIsNotNone(f)
