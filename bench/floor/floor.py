@@ -1166,6 +1166,10 @@ def main():
     ap.add_argument("--verbose", action="store_true", help="the solver's log")
     ap.add_argument("--trajectory", help="write the relaxed trajectory (k x y z) here")
     args = ap.parse_args()
+    if args.trajectory and not args.single:
+        # A bisection keeps no motion, only which horizons were proved: say so rather than
+        # write nothing.
+        ap.error("--trajectory needs --single (a bisection or --prove-ms keeps no trajectory)")
     try:
         first, last = (int(x) for x in args.lines.split("-"))
     except ValueError:
