@@ -824,7 +824,7 @@ class Motion : public hal::Instance {
                 if (e.periods == 0) return;
                 excess_reported_ = true;
                 fmt::print(stderr,
-                           "{}: joint {} was commanded a {} of {:.6g}{} in {} periods (first at "
+                           "{}: joint {} was commanded {} of {:.6g}{} in {} periods (first at "
                            "line {}), above {} = {:.6g}: {}\n",
                            name(), j, what, e.peak, per, e.periods, e.first_line,
                            pin_name(fmt::format("joint.{}.{}", j, param)), e.limit,
@@ -834,8 +834,8 @@ class Motion : public hal::Instance {
                                            : "the kinematics ask more of this motor than the "
                                              "axis limits allow");
             };
-            say(joint_excess_[j].vel, "velocity", "/s", "max-velocity");
-            say(joint_excess_[j].acc, "acceleration", "/s^2", "max-acceleration");
+            say(joint_excess_[j].vel, "a velocity", "/s", "max-velocity");
+            say(joint_excess_[j].acc, "an acceleration", "/s^2", "max-acceleration");
         }
     }
 

@@ -84,15 +84,7 @@ def workspace(machine):
     """Per-axis [lo, hi] the generator keeps every programmed point in (blends stay within 0.5 mm
     of the path, so the margin keeps the tool inside the soft limits).
 
-    5axis-trt: the planner limits the programmed axes, not the motors (docs/cnc-run.md), and a
-    turned table makes a motor run faster than any axis: so far faster that the simulated drive
-    trips on over-speed (SIM_MAX_VEL, twice MAX_VELOCITY) on ordinary programs (reported in
-    docs/soak.md). The soak keeps out of that known gap to test the rest: a cube of 50 mm about the
-    A axis' pivot (0, 0, Z_ROT_POINT), A within +-15 degrees, and the generator stops before and
-    after each rotary move and feeds moves with rotary axes at 1200 mm/min at most. There a
-    diagonal XY rapid gives machine Z at most sin(15) * 141 + 50 = 87 mm/s (trip 100), and a
-    rotation at its axis' velocity moves a point 43 mm from the pivot at most 55 mm/s (A) or
-    35 mm/s in Z (C); every joint also stays inside its travel whatever A and C are."""
+    5axis-trt: a cube of 50 mm about the A axis' pivot (0, 0, Z_ROT_POINT), in which every joint also stays inside its travel whatever A and C are."""
     box = {}
     for l, a in machine.axes.items():
         if machine.linear(l):
@@ -109,6 +101,4 @@ def workspace(machine):
         if l in machine.axes:
             a = machine.axes[l]
             box[l] = (max(a.min_mm + 5, -400.0), min(a.max_mm - 5, 400.0))
-    if machine.kinematics == "kins_xyzac_trt" and "a" in box:
-        box["a"] = (max(box["a"][0], -15.0), min(box["a"][1], 15.0))
     return box

@@ -499,9 +499,9 @@ class Generator:
             self.set_feed(self.length(30, 9000))
 
     def step_rotary(self):
-        """A and C on the table-tilting machine: alone, or with a short linear move; isolated by a
-        stop before (a dwell) and after (G09), fed at 1200 mm/min at most (machine.workspace says
-        why)."""
+        """A and C on the table-tilting machine: alone, or with a short linear move, rapid or fed
+        (up to 9000 mm/min: the planner keeps the motors within their velocity limits under this
+        kinematics, docs/components/motion.md)."""
         if not self.rot:
             return self.step_line()
         letters = self.rng.sample(self.rot, self.rng.randint(1, len(self.rot)))
@@ -509,12 +509,11 @@ class Generator:
         for l in letters:
             lo, hi = self.box[l]
             target[l] = round4(min(hi, max(lo, self.p(l) + self.rng.uniform(-1, 1) * self.length(0.01, 120))))
-        self.emit("G04 P1")
         if self.rng.random() < 0.3:
-            self.emit(f"G0 G09 {self.words(target)}")
+            self.emit(f"G0 {self.words(target)}")
             return
-        if self.rng.random() < 0.5 or self.feed > 1200:
-            self.set_feed(self.length(30, 1200))
+        if self.rng.random() < 0.5:
+            self.set_feed(self.length(30, 9000))
         if self.rng.random() < 0.4:
             d = self.direction()
             step = self.length(0.01, 20)
@@ -522,7 +521,7 @@ class Generator:
             pt = {l: round4(here[l] + d[l] * step) for l in d}
             if self.inside(pt):
                 target.update(pt)
-        self.emit(f"G1 G09 {self.words(target)}{self.feed_word()}")
+        self.emit(f"G1 {self.words(target)}{self.feed_word()}")
 
     STEPS = (("rapid", 8), ("line", 20), ("corner", 14), ("polyline", 8), ("arc", 10),
              ("arc_r", 7), ("circle", 3), ("mode", 8), ("exact_stop", 4), ("dwell", 3),

@@ -100,7 +100,7 @@ def shrink(cnc, machine, lines, failure, workdir, timeout_s, budget_s):
 
 
 def excess_reported(workdir):
-    """Whether motion reported joint velocity/acceleration excesses (tolerated on 5axis-trt)."""
+    """Whether motion reported joint acceleration excesses (tolerated on 5axis-trt)."""
     try:
         with open(os.path.join(workdir, "stderr.txt"), encoding="utf-8") as f:
             return any(TRT_EXCESS.match(line) for line in f)
@@ -190,7 +190,7 @@ def main():
     print(f"soak: {len(jobs)} runs ({len(seeds)} seeds x {len(configs)} configs), {failures} failed, "
           f"{time.monotonic() - t0:.0f} s")
     if noted:
-        print(f"soak: motion reported joint velocity/acceleration excesses (tolerated on 5axis-trt) in "
+        print(f"soak: motion reported joint acceleration excesses (tolerated on 5axis-trt) in "
               f"{len(noted)} runs: {' '.join(noted[:20])}{' ...' if len(noted) > 20 else ''}")
     return 1 if failures else 0
 

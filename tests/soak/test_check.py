@@ -282,12 +282,17 @@ class RunReport(unittest.TestCase):
 
     def test_stderr(self):
         mill, trt = machine(), machine(kins="kins_xyzac_trt")
-        excess = ("motion.0: joint 0 was commanded a velocity of 120/s in 3 periods (first at line 5), "
-                  "above motion.0.joint.0.max-velocity = 100: the kinematics ask more of this motor "
-                  "than the axis limits allow")
+        excess = ("motion.0: joint 0 was commanded an acceleration of 1300/s^2 in 3 periods (first at "
+                  "line 5), above motion.0.joint.0.max-acceleration = 1000: the kinematics ask more of "
+                  "this motor than the axis limits allow")
         self.assertIsNone(check.check_stderr("", mill))
         self.assertIsNone(check.check_stderr(excess, trt))
         self.assertEqual(check.check_stderr(excess, mill).check, "stderr")
+        # The planner keeps 5axis-trt's motors within their velocity limits: an excess is a failure.
+        too_fast = ("motion.0: joint 0 was commanded a velocity of 120/s in 3 periods (first at line 5), "
+                    "above motion.0.joint.0.max-velocity = 100: the kinematics ask more of this motor "
+                    "than the axis limits allow")
+        self.assertEqual(check.check_stderr(too_fast, trt).check, "stderr")
         self.assertEqual(check.check_stderr("prog.ngc:3:1: warning: odd", trt).check, "stderr")
         stale = "halrun: removed stale HAL instance 'cnc-run-27728' left by dead process 27728"
         self.assertIsNone(check.check_stderr(stale, mill))
