@@ -1225,20 +1225,25 @@ void Runtime::add_time_pin(const std::string& name, Component* owner, void** fie
     pins_[name] = std::make_unique<Pin>(Pin{name, Type::S32, Dir::Out, owner, field, cell, nullptr});
 }
 
+namespace {
+// A function's or thread's timing param: its name after the owner's, where it lies in the
+// owner's timing block, its type and direction.
+struct TimingParam {
+    const char* suffix;
+    std::size_t offset;
+    Type type;
+    ParamDir dir;
+};
+}  // namespace
+
 void Runtime::add_funct_timing(Funct& f, LoadTransaction& building) {
     const auto pin = f.name + ".time";
     add_time_pin(pin, f.component, &f.time_pin, building.allocate(sizeof(PinCell)));
     building.pins.push_back(pin);
     f.timing = building.allocate(sizeof(FunctTiming));
     *segment_->at<FunctTiming>(f.timing) = FunctTiming{};
-    struct P {
-        const char* suffix;
-        std::size_t offset;
-        Type type;
-        ParamDir dir;
-    };
-    for (auto p : {P{"tmax", offsetof(FunctTiming, tmax), Type::S32, ParamDir::RW},
-                   P{"tmax-increased", offsetof(FunctTiming, tmax_increased), Type::Bit, ParamDir::RO}}) {
+    for (auto p : {TimingParam{"tmax", offsetof(FunctTiming, tmax), Type::S32, ParamDir::RW},
+                   TimingParam{"tmax-increased", offsetof(FunctTiming, tmax_increased), Type::Bit, ParamDir::RO}}) {
         auto name = fmt::format("{}.{}", f.name, p.suffix);
         if (params_.count(name)) throw Error(fmt::format("duplicate parameter '{}'", name));
         params_[name] = std::make_unique<ParamRecord>(ParamRecord{name, p.type, p.dir, f.component, f.timing + p.offset, true});
@@ -1261,18 +1266,12 @@ Thread& Runtime::create_thread(const std::string& name, std::int64_t period_ns, 
     stats->funct_sample = sim_clock_ ? 0 : 1000;
     auto t = std::make_unique<Thread>(name, period_ns, fp, cpu, stats);
     t->next_deadline_ns = sim_now_ns_ + period_ns;
-    struct P {
-        const char* suffix;
-        std::size_t offset;
-        Type type;
-        ParamDir dir;
-    };
-    for (auto p : {P{"tmax", offsetof(ThreadStats, tmax), Type::S32, ParamDir::RW},
-                   P{"wakeup-err", offsetof(ThreadStats, wakeup_err_ns), Type::S64, ParamDir::RO},
-                   P{"wakeup-err-max", offsetof(ThreadStats, wakeup_max_ns), Type::S64, ParamDir::RW},
-                   P{"late-cycles", offsetof(ThreadStats, late_cycles), Type::U64, ParamDir::RO},
-                   P{"cycles", offsetof(ThreadStats, cycles), Type::U64, ParamDir::RO},
-                   P{"funct-sample", offsetof(ThreadStats, funct_sample), Type::U32, ParamDir::RW}}) {
+    for (auto p : {TimingParam{"tmax", offsetof(ThreadStats, tmax), Type::S32, ParamDir::RW},
+                   TimingParam{"wakeup-err", offsetof(ThreadStats, wakeup_err_ns), Type::S64, ParamDir::RO},
+                   TimingParam{"wakeup-err-max", offsetof(ThreadStats, wakeup_max_ns), Type::S64, ParamDir::RW},
+                   TimingParam{"late-cycles", offsetof(ThreadStats, late_cycles), Type::U64, ParamDir::RO},
+                   TimingParam{"cycles", offsetof(ThreadStats, cycles), Type::U64, ParamDir::RO},
+                   TimingParam{"funct-sample", offsetof(ThreadStats, funct_sample), Type::U32, ParamDir::RW}}) {
         auto pname = fmt::format("{}.{}", name, p.suffix);
         params_[pname] = std::make_unique<ParamRecord>(ParamRecord{pname, p.type, p.dir, nullptr, stats_off + p.offset, true});
     }

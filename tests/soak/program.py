@@ -444,9 +444,10 @@ class Generator:
                       .replace("  ", " "))
 
     def step_arc_off(self):
-        """An I J arc whose end is off its circle by up to arc_end_off mm (the interpreter accepts
-        0.01 mm, the planner max(0.005 mm, 0.1 % of the radius)), half of them nearly full
-        circles (end within a few degrees of the start)."""
+        """An I J arc whose end is off its circle by up to arc_end_off mm (the interpreter and the
+        planner accept max(0.01 mm, 0.1 % of the radius)), half of them nearly full circles (end
+        within a few degrees of the start, which the planner refuses when the circle through
+        both ends would leave the programmed one: docs/soak.md, finding 2)."""
         found = self.arc_common()
         if not found:
             return
@@ -456,7 +457,7 @@ class Generator:
         sweep = self.rng.uniform(1.97, 1.9999) * math.pi if self.rng.random() < 0.5 else \
             self.rng.uniform(0.3, 1.9) * math.pi
         th1 = th0 + (sweep if ccw else -sweep)
-        off = min(self.arc_end_off, 0.99 * max(0.005, 1e-3 * r)) * self.rng.uniform(0.3, 1.0)
+        off = min(self.arc_end_off, 0.99 * max(0.01, 1e-3 * r)) * self.rng.uniform(0.3, 1.0)
         r_end = r + self.rng.choice((-1, 1)) * off
         end = {lu: round4(cu + r_end * math.cos(th1)), lv: round4(cv + r_end * math.sin(th1))}
         if abs(math.hypot(end[lu] - cu, end[lv] - cv) - r) > 0.99 * max(0.005, 1e-3 * r):
