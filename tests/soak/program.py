@@ -382,7 +382,8 @@ class Generator:
         return Model.PLANES[plane]
 
     def arc_common(self):
-        """Plane, centre and radius of an arc whose whole circle fits in the workspace."""
+        """Plane, start, centre, radius, direction (counter-clockwise?) and start angle of an arc
+        whose whole circle fits in the workspace."""
         u, v, n = self.set_plane()
         lu, lv, ln = "xyz"[u], "xyz"[v], "xyz"[n]
         su, sv = self.p(lu), self.p(lv)
@@ -395,7 +396,8 @@ class Generator:
             fits = (self.box[lu][0] <= cu - r and cu + r <= self.box[lu][1] and
                     self.box[lv][0] <= cv - r and cv + r <= self.box[lv][1])
             if fits and r > 0.02:
-                return (lu, lv, ln), (su, sv), (cu, cv), r
+                ccw = self.rng.random() < 0.5
+                return (lu, lv, ln), (su, sv), (cu, cv), r, ccw, math.atan2(sv - cv, su - cu)
         return None
 
     def helix_end(self, ln, arc_len):
@@ -415,9 +417,7 @@ class Generator:
         found = self.arc_common()
         if not found:
             return
-        (lu, lv, ln), (su, sv), (cu, cv), r = found
-        ccw = self.rng.random() < 0.5
-        th0 = math.atan2(sv - cv, su - cu)
+        (lu, lv, ln), (su, sv), (cu, cv), r, ccw, th0 = found
         if full:
             sweep = TWO_PI
         elif by_radius:
@@ -451,9 +451,7 @@ class Generator:
         found = self.arc_common()
         if not found:
             return
-        (lu, lv, ln), (su, sv), (cu, cv), r = found
-        ccw = self.rng.random() < 0.5
-        th0 = math.atan2(sv - cv, su - cu)
+        (lu, lv, ln), (su, sv), (cu, cv), r, ccw, th0 = found
         sweep = self.rng.uniform(1.97, 1.9999) * math.pi if self.rng.random() < 0.5 else \
             self.rng.uniform(0.3, 1.9) * math.pi
         th1 = th0 + (sweep if ccw else -sweep)
