@@ -349,8 +349,7 @@ Element make_arc(const AxisArray& start, const PathSegment& seg) {
     const double chord_u = seg.end_mm[i] - start[i], chord_v = seg.end_mm[j] - start[j];
     const double chord = std::hypot(chord_u, chord_v);
     if (mismatch > 0 && chord > 1e-9) {
-        const PlaneArc programmed{cu, cv, r0, std::atan2(sv, su),
-                                  arc_sweep(std::atan2(sv, su), std::atan2(ev, eu), seg.turns)};
+        const double pcu = cu, pcv = cv, psu = su, psv = sv, peu = eu, pev = ev, pr = r0;
         const double mu = (start[i] + seg.end_mm[i]) / 2, mv = (start[j] + seg.end_mm[j]) / 2;
         const double nu = -chord_v / chord, nv = chord_u / chord;  // bisector direction
         const double t = (cu - mu) * nu + (cv - mv) * nv;
@@ -365,7 +364,9 @@ Element make_arc(const AxisArray& start, const PathSegment& seg) {
         // short arc the path hardly changes, but a nearly full circle whose end is a little off
         // its start becomes another circle through the two close points, a dot (X100 Y100,
         // G2 X100.004 Y100 I-5: radius 0.002 mm). Such an arc is refused, not run.
-        if (moved_mm + std::fabs(r0 - programmed.r) > allowed_mm) {
+        if (moved_mm + std::fabs(r0 - pr) > allowed_mm) {
+            const PlaneArc programmed{pcu, pcv, pr, std::atan2(psv, psu),
+                                      arc_sweep(std::atan2(psv, psu), std::atan2(pev, peu), seg.turns)};
             const PlaneArc moved{cu, cv, r0, std::atan2(sv, su),
                                  arc_sweep(std::atan2(sv, su), std::atan2(ev, eu), seg.turns)};
             const double apart_mm = arcs_apart(programmed, moved);
